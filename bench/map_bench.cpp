@@ -1,0 +1,192 @@
+#include "map_bench.h"
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "pvr/cpu/cpu_backend.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+
+struct QueryPoint {
+  Vec3 position, normal;
+};
+
+template <class F>
+double minTimeMs(int repeats, F&& f) {
+  double best = INFINITY;
+  for (int r = 0; r < repeats; ++r) {
+    auto start = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+  return best;
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  if (out.empty()) throw Error("empty list '" + s + "'");
+  return out;
+}
+
+uint32_t parseGrid(const std::string& s, uint32_t& nx, uint32_t& ny) {
+  char x = 0;
+  std::stringstream ss(s);
+  if (!(ss >> nx >> x >> ny) || (x != 'x' && x != 'X') || nx == 0 || ny == 0 || nx > 8192 || ny > 8192)
+    throw Error("expected WxH with positive integers up to 8192, got '" + s + "'");
+  return nx * ny;
+}
+
+std::string cpuName() {
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown CPU";
+}
+
+// First hits of the left eye's pixel-centre rays on a coarse grid: realistic query points.
+std::vector<QueryPoint> eyeHitPoints(const CpuBackend& backend, const StereoRig& rig, uint32_t w, uint32_t h) {
+  EyeCamera cam = rig.eye(Eye::Left);
+  SceneView view = backend.scene().view();
+  std::vector<QueryPoint> points;
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x) {
+      Ray ray = cam.generateRay((x + 0.5f) * cam.width / w, (y + 0.5f) * cam.height / h);
+      Hit hit;
+      if (!backend.intersector().intersect(ray, INFINITY, hit)) continue;
+      SurfacePoint sp = view.surfacePoint(hit);
+      if (view.materials[sp.materialId].isSpecular()) continue;
+      points.push_back({sp.position, dot(ray.dir, sp.geometricNormal) < 0 ? sp.geometricNormal : -sp.geometricNormal});
+    }
+  return points;
+}
+
+template <class Map>
+void estimateAll(const Map& map, const std::vector<QueryPoint>& q, const DensityParams& p, std::vector<Vec3>& out) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, q.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) out[i] = estimateFluxDensity(map, q[i].position, q[i].normal, p);
+  });
+}
+
+// Largest relative difference between two estimate sets, relative to the mean magnitude.
+double maxRelativeDifference(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double mean = 0, worst = 0;
+  for (const Vec3& v : a) mean += luminance(v);
+  mean = std::max(mean / std::max<size_t>(a.size(), 1), 1e-30);
+  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, double(maxComponent(max(a[i] - b[i], b[i] - a[i]))));
+  return worst / mean;
+}
+
+}  // namespace
+
+int runMapBench(const MapBenchArgs& args) {
+  if (args.k < 1 || args.k > kMaxKnn) throw Error("--k must be between 1 and " + std::to_string(kMaxKnn));
+  if (args.repeats < 1 || args.repeats > 1000) throw Error("--repeats must be between 1 and 1000");
+  uint32_t qw, qh;
+  parseGrid(args.queries, qw, qh);
+  std::vector<float> radii;
+  for (const std::string& r : splitList(args.radii)) {
+    char* end = nullptr;
+    float v = std::strtof(r.c_str(), &end);
+    if (*end != '\0' || !(v > 0.0f) || !std::isfinite(v)) throw Error("radii must be positive numbers, got '" + r + "'");
+    radii.push_back(v);
+  }
+  std::vector<std::pair<uint32_t, uint32_t>> grids;
+  for (const std::string& g : splitList(args.photons)) {
+    uint32_t nx, ny;
+    parseGrid(g, nx, ny);
+    grids.push_back({nx, ny});
+  }
+
+  Scene scene = loadScene(args.scene);
+  CpuBackend backend(scene);
+  std::vector<QueryPoint> queries = eyeHitPoints(backend, scene.rig, qw, qh);
+  int threads = tbb::info::default_concurrency();
+  std::printf("photon-map benchmark, CPU backend: %s, %d threads\n", cpuName().c_str(), threads);
+  std::printf("scene %s; %zu query points (diffuse first hits of the left eye on a %ux%u grid); kNN k=%d; "
+              "minimum of %d runs\n\n",
+              scene.name.c_str(), queries.size(), qw, qh, args.k, args.repeats);
+  std::printf("| photons | stored | radius | kd build ms | grid build ms | kd radius ms | grid radius ms | kd kNN ms | "
+              "grid kNN ms | photons/query | check |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+
+  nlohmann::json results = nlohmann::json::array();
+  bool allOk = true;
+  for (auto [nx, ny] : grids) {
+    PhotonTraceParams tp;
+    tp.photonCount = nx * ny;
+    tp.storeDirect = true;  // the paper's map holds every photon
+    std::vector<Photon> photons = backend.tracePhotons(tp);
+    KdTree tree;
+    double kdBuild = minTimeMs(args.repeats, [&] { tree = KdTree::build(photons); });
+    for (float radius : radii) {
+      HashGrid grid;
+      double gridBuild = minTimeMs(args.repeats, [&] { grid = HashGrid::build(photons, radius); });
+      DensityParams radiusSum{radius, Estimator::Radius, args.k};
+      DensityParams knn{radius, Estimator::Knn, args.k};
+      std::vector<Vec3> kdR(queries.size()), gridR(queries.size()), kdK(queries.size()), gridK(queries.size());
+      double kdRadius = minTimeMs(args.repeats, [&] { estimateAll(tree.view(), queries, radiusSum, kdR); });
+      double gridRadius = minTimeMs(args.repeats, [&] { estimateAll(grid.view(), queries, radiusSum, gridR); });
+      double kdKnn = minTimeMs(args.repeats, [&] { estimateAll(tree.view(), queries, knn, kdK); });
+      double gridKnn = minTimeMs(args.repeats, [&] { estimateAll(grid.view(), queries, knn, gridK); });
+      // Self-check: the two maps find the same photons, so the estimates agree up to the order of
+      // the float additions.
+      double diffRadius = maxRelativeDifference(kdR, gridR), diffKnn = maxRelativeDifference(kdK, gridK);
+      bool ok = diffRadius < 1e-4 && diffKnn < 1e-4;
+      allOk = allOk && ok;
+      double found = 0;
+      HashGridView gv = grid.view();
+      for (const QueryPoint& q : queries) {
+        float r2 = radius * radius;
+        gv.search(q.position, r2, [&](uint32_t, float, float&) { found += 1; });
+      }
+      found /= std::max<size_t>(queries.size(), 1);
+      std::printf("| %ux%u | %zu | %.3g | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %s |\n", nx, ny,
+                  photons.size(), radius, kdBuild, gridBuild, kdRadius, gridRadius, kdKnn, gridKnn, found,
+                  ok ? "ok" : "MISMATCH");
+      std::fflush(stdout);
+      results.push_back({{"photons", std::to_string(nx) + "x" + std::to_string(ny)},
+                         {"stored_photons", photons.size()},
+                         {"radius", radius},
+                         {"kd_build_ms", kdBuild},
+                         {"grid_build_ms", gridBuild},
+                         {"kd_radius_query_ms", kdRadius},
+                         {"grid_radius_query_ms", gridRadius},
+                         {"kd_knn_query_ms", kdKnn},
+                         {"grid_knn_query_ms", gridKnn},
+                         {"photons_in_radius_per_query", found},
+                         {"max_relative_difference_radius", diffRadius},
+                         {"max_relative_difference_knn", diffKnn},
+                         {"check", ok}});
+    }
+  }
+  if (!args.json.empty()) {
+    nlohmann::json doc = {{"benchmark", "photon maps (CPU)"},
+                          {"cpu", cpuName()},
+                          {"threads", threads},
+                          {"scene", scene.name},
+                          {"query_points", queries.size()},
+                          {"query_grid", args.queries},
+                          {"k", args.k},
+                          {"repeats", args.repeats},
+                          {"results", results}};
+    std::ofstream out(args.json);
+    if (!out) throw Error("cannot write '" + args.json + "'");
+    out << doc.dump(2) << "\n";
+    std::printf("\nwrote %s\n", args.json.c_str());
+  }
+  if (!allOk) std::fprintf(stderr, "photonvr: error: the kd-tree and the hash grid disagree (see the check column)\n");
+  return allOk ? 0 : 1;
+}
+
+}  // namespace pvr

@@ -1,0 +1,225 @@
+#include "pvr/app/cli.h"
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <new>
+#include <regex>
+
+#include "map_bench.h"
+#include "pvr/render/renderer.h"
+#include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+
+struct Size2 {
+  long long x = 0, y = 0;
+};
+
+// "WxH" (also for photons: "256x256"), or a single number N for photon counts meaning N photons.
+Size2 parseSize(const std::string& text, const std::string& what, bool allowSingle) {
+  static const std::regex pair(R"(^\s*(\d{1,9})\s*[xX]\s*(\d{1,9})\s*$)");
+  static const std::regex single(R"(^\s*(\d{1,12})\s*$)");
+  std::smatch m;
+  if (std::regex_match(text, m, pair)) return {std::stoll(m[1]), std::stoll(m[2])};
+  if (allowSingle && std::regex_match(text, m, single)) return {std::stoll(m[1]), 1};
+  throw Error(what + " must be WxH with positive integers, got '" + text + "'");
+}
+
+float parseFloat(const std::string& text, const std::string& what) {
+  try {
+    size_t used = 0;
+    float v = std::stof(text, &used);
+    if (used != text.size()) throw std::invalid_argument(text);
+    return v;
+  } catch (const std::exception&) {
+    throw Error(what + " must be a number, got '" + text + "'");
+  }
+}
+
+struct RenderArgs {
+  std::string scene = "cornell";
+  std::string photons = "256x256";
+  std::string radius = "0.05";
+  std::string map = "hashgrid";
+  std::string estimator = "radius";
+  int k = 32;
+  std::string eyes = "both";
+  std::string eyeSize;  // empty: the scene's rig (1440x1600 for built-in scenes)
+  std::string ipd;      // empty: the scene's rig (63 mm)
+  int spp = 1;
+  uint32_t seed = 1;
+  int photonDepth = 8;
+  int specularDepth = 8;
+  std::string shading = "full";
+  std::string out = "out/render";
+  float exposure = 1.0f;
+};
+
+void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_option("--photons", a.photons, "Emitted photons as WxH (the paper's 128x128 .. 512x512) or a count")
+      ->capture_default_str();
+  cmd.add_option("--radius", a.radius, "Search radius of density estimation (the maximum radius for kNN), scene units")
+      ->capture_default_str();
+  cmd.add_option("--map", a.map, "Photon map: hashgrid | kdtree")->capture_default_str();
+  cmd.add_option("--estimator", a.estimator, "Density estimation: radius (fixed radius, no heap) | knn (max-heap)")
+      ->capture_default_str();
+  cmd.add_option("--k", a.k, "Photons per kNN estimate (1..64)")->capture_default_str();
+  cmd.add_option("--seed", a.seed, "Seed of the counter-based random numbers")->capture_default_str();
+  cmd.add_option("--photon-depth", a.photonDepth, "Maximum surface interactions per photon path")->capture_default_str();
+}
+
+RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
+  RenderOptions o;
+  Size2 photons = parseSize(a.photons, "--photons", true);
+  if (photons.x <= 0 || photons.y <= 0) throw Error("--photons must be positive, got '" + a.photons + "'");
+  if (photons.x * photons.y > (1ll << 26)) throw Error("--photons is too large: at most 67108864 (8192x8192)");
+  o.photonsX = uint32_t(photons.x);
+  o.photonsY = uint32_t(photons.y);
+  o.gather.density.radius = parseFloat(a.radius, "--radius");
+  if (!(o.gather.density.radius > 0.0f) || !std::isfinite(o.gather.density.radius))
+    throw Error("--radius must be a positive finite number, got '" + a.radius + "'");
+  if (a.map == "hashgrid") o.map = PhotonMapKind::HashGrid;
+  else if (a.map == "kdtree") o.map = PhotonMapKind::KdTree;
+  else throw Error("--map must be hashgrid or kdtree, got '" + a.map + "'");
+  if (a.estimator == "radius") o.gather.density.estimator = Estimator::Radius;
+  else if (a.estimator == "knn") o.gather.density.estimator = Estimator::Knn;
+  else throw Error("--estimator must be radius or knn, got '" + a.estimator + "'");
+  if (a.k < 1 || a.k > kMaxKnn) throw Error("--k must be between 1 and " + std::to_string(kMaxKnn));
+  o.gather.density.k = a.k;
+  if (a.eyes == "both") o.eyes[0] = o.eyes[1] = true;
+  else if (a.eyes == "left") o.eyes[0] = true, o.eyes[1] = false;
+  else if (a.eyes == "right") o.eyes[0] = false, o.eyes[1] = true;
+  else throw Error("--eyes must be left, right or both, got '" + a.eyes + "'");
+  if (!a.eyeSize.empty()) {
+    Size2 s = parseSize(a.eyeSize, "--eye-size", false);
+    if (s.x < 1 || s.y < 1 || s.x > 8192 || s.y > 8192)
+      throw Error("--eye-size must be between 1x1 and 8192x8192, got '" + a.eyeSize + "'");
+    rig.width = int(s.x);
+    rig.height = int(s.y);
+  }
+  if (!a.ipd.empty()) {
+    float ipd = parseFloat(a.ipd, "--ipd");
+    if (!(ipd >= 0.0f && ipd <= 1.0f)) throw Error("--ipd must be between 0 and 1 metre, got '" + a.ipd + "'");
+    rig.ipd = ipd;
+  }
+  if (a.spp < 1 || a.spp > 4096) throw Error("--spp must be between 1 and 4096");
+  o.gather.samplesPerPixel = a.spp;
+  o.gather.seed = a.seed;
+  o.maxPhotonDepth = a.photonDepth;
+  o.gather.maxSpecularDepth = a.specularDepth;
+  if (a.shading == "full") o.gather.mode = ShadingMode::Full;
+  else if (a.shading == "photons") o.gather.mode = ShadingMode::PhotonMapOnly;
+  else throw Error("--shading must be full or photons, got '" + a.shading + "'");
+  if (!(a.exposure > 0.0f) || !std::isfinite(a.exposure)) throw Error("--exposure must be a positive number");
+  validateOptions(o, rig);
+  return o;
+}
+
+int runRender(const RenderArgs& a) {
+  Scene scene = loadScene(a.scene);
+  StereoRig rig = scene.rig;
+  RenderOptions options = toOptions(a, rig);
+  if (scene.skippedTriangles() > 0)
+    std::cerr << "photonvr: warning: skipped " << scene.skippedTriangles()
+              << " degenerate or non-finite triangles\n";
+  CpuBackend backend(scene);
+  std::printf("scene %s: %u triangles, %u emitting; eyes %dx%d, IPD %.1f mm\n", scene.name.c_str(),
+              scene.triangleCount(), scene.lightTriangleCount(), rig.width, rig.height, rig.ipd * 1000.0f);
+  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, seed %u, backend cpu\n", options.photonsX,
+              options.photonsY, options.gather.density.radius, a.map.c_str(), a.estimator.c_str(),
+              options.gather.density.estimator == Estimator::Knn ? (" (k=" + std::to_string(a.k) + ")").c_str() : "",
+              options.gather.samplesPerPixel, options.gather.seed);
+  FrameResult frame = renderFrame(backend, rig, options);
+  std::printf("  photon trace  %9.2f ms  (%zu photons stored)\n", frame.timings.photonTraceMs, frame.storedPhotons);
+  std::printf("  map build     %9.2f ms  (%.1f MiB)\n", frame.timings.mapBuildMs, frame.mapBytes / 1048576.0);
+  const char* names[2] = {"left", "right"};
+  for (int e = 0; e < 2; ++e)
+    if (options.eyes[e]) std::printf("  %-5s eye     %9.2f ms\n", names[e], frame.timings.eyeMs[e]);
+  std::printf("  total         %9.2f ms\n", frame.timings.totalMs());
+  std::filesystem::path prefix(a.out);
+  if (prefix.has_parent_path()) std::filesystem::create_directories(prefix.parent_path());
+  for (int e = 0; e < 2; ++e) {
+    if (!options.eyes[e]) continue;
+    for (const char* ext : {".png", ".exr"}) {
+      std::string path = a.out + "_" + names[e] + ext;
+      writeImage(frame.eyes[e].image, path, a.exposure);
+      std::printf("wrote %s\n", path.c_str());
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int runCli(int argc, char** argv) {
+  CLI::App app{"photonvr: real-time photon mapping for VR headsets (CPU reference backend: Embree + TBB)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "photonvr 0.1.0");
+
+  RenderArgs ra;
+  CLI::App* render = app.add_subcommand("render", "Render a stereo pair of a scene to PNG (sRGB) and EXR (linear)");
+  render->footer(
+      "Scenes: a built-in name (cornell, cornell-caustics), a JSON scene file (docs/scene-format.md), or a mesh file\n"
+      "(.gltf, .glb, .obj+.mtl via assimp). Materials: base colour -> diffuse, emissive -> area light,\n"
+      "metallic + smooth -> mirror, transmission / ior -> glass. Textures are not supported yet: only constant\n"
+      "material factors are used.\n"
+      "Defaults render the Cornell box at 1440x1600 per eye with 256x256 photons in a few seconds on 2 cores.");
+  render->add_option("scene", ra.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
+  addRenderOptions(*render, ra);
+  render->add_option("--eyes", ra.eyes, "Eyes to render: left | right | both")->capture_default_str();
+  render->add_option("--eye-size", ra.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
+  render->add_option("--ipd", ra.ipd, "Interpupillary distance in metres (default: the scene's rig, 0.063)");
+  render->add_option("--spp", ra.spp, "Samples per pixel")->capture_default_str();
+  render->add_option("--specular-depth", ra.specularDepth, "Mirror/glass bounces followed from the eye")
+      ->capture_default_str();
+  render->add_option("--shading", ra.shading,
+                     "full (direct light by shadow rays + photon map for caustics/indirect) | photons (photon map "
+                     "alone, the paper's formulation)")
+      ->capture_default_str();
+  render->add_option("--exposure", ra.exposure, "Scale applied before the sRGB PNG's clamp")->capture_default_str();
+  render->add_option("--out", ra.out, "Output prefix: writes PREFIX_left.png/.exr and PREFIX_right.png/.exr")
+      ->capture_default_str();
+
+  MapBenchArgs ba;
+  CLI::App* bench = app.add_subcommand("bench", "Benchmark photon maps on the CPU: kd-tree vs hash grid, build and "
+                                                "query, radius sum vs kNN, on the paper's grid of photons and radii");
+  bench->add_option("scene", ba.scene, "Scene whose photons and eye hit points are used")->capture_default_str();
+  bench->add_option("--photons", ba.photons, "Comma-separated photon grids")->capture_default_str();
+  bench->add_option("--radii", ba.radii, "Comma-separated search radii")->capture_default_str();
+  bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye")
+      ->capture_default_str();
+  bench->add_option("--k", ba.k, "Photons per kNN query")->capture_default_str();
+  bench->add_option("--repeats", ba.repeats, "Timed repetitions (the minimum is reported)")->capture_default_str();
+  bench->add_option("--json", ba.json, "Also write the results as JSON to this file");
+
+  try {
+    app.parse(argc, argv);
+    if (render->parsed()) return runRender(ra);
+    if (bench->parsed()) return runMapBench(ba);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "photonvr: error: " << e.what() << " (see photonvr --help)\n";
+    return 2;
+  } catch (const Error& e) {
+    std::cerr << "photonvr: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "photonvr: error: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "photonvr: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace pvr

@@ -1,0 +1,53 @@
+#include "pvr/cpu/cpu_backend.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace pvr {
+
+std::vector<Photon> CpuBackend::tracePhotons(const PhotonTraceParams& params) const {
+  SceneView view = scene_.view();
+  std::vector<Photon> stored;
+  const uint32_t chunk = 1u << 16;  // bounds the scratch memory to chunk * maxDepth photons
+  const uint32_t slots = uint32_t(std::max(params.maxDepth, 1));
+  std::vector<Photon> scratch(size_t(chunk) * slots);
+  std::vector<int> counts(chunk);
+  for (uint32_t first = 0; first < params.photonCount; first += chunk) {
+    uint32_t n = std::min(chunk, params.photonCount - first);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 256), [&](const tbb::blocked_range<uint32_t>& r) {
+      for (uint32_t i = r.begin(); i < r.end(); ++i)
+        counts[i] = tracePhoton(view, intersector_, params, first + i, &scratch[size_t(i) * slots]);
+    });
+    for (uint32_t i = 0; i < n; ++i)
+      stored.insert(stored.end(), scratch.begin() + size_t(i) * slots, scratch.begin() + size_t(i) * slots + counts[i]);
+  }
+  return stored;
+}
+
+template <class Map>
+void CpuBackend::renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                               PixelSample* out) const {
+  SceneView view = scene_.view();
+  // 16x16 tiles: coherent rays per task and good load balance.
+  tbb::parallel_for(tbb::blocked_range2d<int>(0, camera.height, 16, 0, camera.width, 16),
+                    [&](const tbb::blocked_range2d<int>& r) {
+                      for (int y = r.rows().begin(); y < r.rows().end(); ++y)
+                        for (int x = r.cols().begin(); x < r.cols().end(); ++x)
+                          out[size_t(y) * camera.width + x] =
+                              shadePixel(view, intersector_, map, params, camera, eye, x, y);
+                    });
+}
+
+void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
+                           PixelSample* out) const {
+  renderEyeWith(camera, eye, params, map, out);
+}
+
+void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                           PixelSample* out) const {
+  renderEyeWith(camera, eye, params, map, out);
+}
+
+}  // namespace pvr

@@ -1,0 +1,38 @@
+#pragma once
+// The CPU reference backend: the shared photon-tracing and gathering code over Embree, with TBB
+// parallel loops. Every result is independent of thread count and scheduling.
+#include <vector>
+
+#include "pvr/cpu/embree_intersector.h"
+#include "pvr/photon/gather.h"
+#include "pvr/photon/hash_grid.h"
+#include "pvr/photon/kd_tree.h"
+#include "pvr/photon/photon_trace.h"
+
+namespace pvr {
+
+class CpuBackend {
+ public:
+  explicit CpuBackend(const Scene& scene) : scene_(scene), intersector_(scene) {}
+
+  // Traces params.photonCount photons; stored photons come out in photon-index order.
+  std::vector<Photon> tracePhotons(const PhotonTraceParams& params) const;
+
+  // Shades every pixel of one eye into `out` (width * height entries, row-major, top row first).
+  void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
+                 PixelSample* out) const;
+  void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                 PixelSample* out) const;
+
+  const Scene& scene() const { return scene_; }
+  const EmbreeIntersector& intersector() const { return intersector_; }
+
+ private:
+  template <class Map>
+  void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                     PixelSample* out) const;
+  const Scene& scene_;
+  EmbreeIntersector intersector_;
+};
+
+}  // namespace pvr

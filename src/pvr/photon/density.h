@@ -1,0 +1,46 @@
+#pragma once
+// Density estimation, the main paper's equation 1:
+//   L_r(x, w) ~ 1 / (pi r^2) * sum_p f_r(x, w_p, w) * dPhi_p
+// either over all photons within a fixed radius (no heap: the paper's choice) or over the k
+// nearest within a maximum radius, with r the k-th distance (max-heap, radius shrinking).
+// Works on any photon map with `search(q, r2, visitor)`: HashGridView, KdTreeView.
+#include "pvr/photon/knn_heap.h"
+#include "pvr/photon/photon.h"
+
+namespace pvr {
+
+enum class Estimator : int { Radius = 0, Knn = 1 };
+
+struct DensityParams {
+  float radius = 0.05f;  ///< search radius (the maximum radius for kNN)
+  Estimator estimator = Estimator::Radius;
+  int k = 32;  ///< photons for kNN, 1..kMaxKnn
+};
+
+// Irradiance-like flux density sum(dPhi) / (pi r^2) at x on a surface with unit normal n facing
+// the viewer; photons that arrived from behind the surface are ignored. Multiply by the diffuse
+// BRDF (albedo / pi) for radiance.
+template <class PhotonMap>
+PVR_HOST_DEVICE Vec3 estimateFluxDensity(const PhotonMap& map, Vec3 x, Vec3 n, const DensityParams& params) {
+  float r2 = params.radius * params.radius;
+  if (params.estimator == Estimator::Radius) {
+    Vec3 sum{0, 0, 0};
+    map.search(x, r2, [&](uint32_t i, float, float&) {
+      const Photon& p = map.photons[i];
+      if (dot(p.direction, n) < 0.0f) sum += p.power;
+    });
+    return sum * (1.0f / (kPi * r2));
+  }
+  KnnHeap heap(params.k);
+  map.search(x, r2, [&](uint32_t i, float d2, float& searchR2) {
+    if (dot(map.photons[i].direction, n) < 0.0f) heap.offer(d2, i, searchR2);
+  });
+  if (heap.size == 0) return {0, 0, 0};
+  Vec3 sum{0, 0, 0};
+  for (int j = 0; j < heap.size; ++j) sum += map.photons[heap.index[j]].power;
+  // Fewer than k photons in reach: the estimate's support is the whole maximum radius.
+  float area = kPi * (heap.full() ? heap.maxDist2() : r2);
+  return area > 0.0f ? sum * (1.0f / area) : Vec3{0, 0, 0};
+}
+
+}  // namespace pvr

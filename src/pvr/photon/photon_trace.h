@@ -1,0 +1,83 @@
+#pragma once
+// Photon tracing from the area lights (the first pass of photon mapping), written once for any
+// Intersector with `bool intersect(const Ray&, float tMax, Hit&) const`.
+//
+// Emission: a light triangle chosen in proportion to its power, a uniform point on it, a
+// cosine-weighted direction; the photon carries Le * pi * area / (pdf_pick * N), which is exactly
+// Phi / N when all lights share one colour. At a diffuse surface the photon is stored, then
+// continues with Russian roulette (probability = max albedo component, power scaled so the
+// expectation is unchanged). Mirrors reflect and glass reflects or refracts (by Fresnel); photons
+// are never stored on them.
+#include "pvr/camera/stereo_rig.h"
+#include "pvr/photon/photon.h"
+#include "pvr/shading/scene_view.h"
+#include "pvr/util/rng.h"
+
+namespace pvr {
+
+struct PhotonTraceParams {
+  uint32_t photonCount = 256 * 256;  ///< emitted photons N
+  uint32_t seed = 1;
+  int maxDepth = 8;  ///< surface interactions per photon path
+  bool storeDirect = false;  ///< also store L D photons (when the photon map alone shades)
+};
+
+// The emitted photon i: origin, direction and power.
+PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTraceParams& params, uint32_t i) {
+  CounterRng rng(params.seed, i, 0);
+  float uPick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+  LightSample ls = sampleLight(scene, uPick, u1, u2);
+  Vec3 local = sampleCosineHemisphere(rng.uniform(), rng.uniform());
+  Photon p;
+  p.position = ls.position;
+  p.direction = Frame::fromNormal(ls.normal).toWorld(local);
+  p.power = ls.emission * (kPi / (ls.pdfArea * float(params.photonCount)));
+  return p;
+}
+
+// Traces photon i; writes at most params.maxDepth photons to `out` and returns how many.
+template <class Intersector>
+PVR_HOST_DEVICE int tracePhoton(const SceneView& scene, const Intersector& intersector,
+                                const PhotonTraceParams& params, uint32_t i, Photon* out) {
+  Photon photon = emitPhoton(scene, params, i);
+  Ray ray{photon.position, photon.direction};
+  Vec3 offsetNormal = photon.direction;  // leave the light along its emission side
+  int stored = 0;
+  float eps = scene.rayEpsilon();
+  for (int depth = 0; depth < params.maxDepth; ++depth) {
+    ray.origin = ray.origin + offsetNormal * eps;
+    Hit hit;
+    if (!intersector.intersect(ray, INFINITY, hit)) break;
+    SurfacePoint sp = scene.surfacePoint(hit);
+    const Material& m = scene.materials[sp.materialId];
+    CounterRng rng(params.seed, i, uint32_t(depth) + 1);
+    Vec3 dir = ray.dir;
+    if (m.type == MaterialType::Diffuse) {
+      Vec3 nFacing = dot(dir, sp.geometricNormal) < 0.0f ? sp.geometricNormal : -sp.geometricNormal;
+      Vec3 nShade = dot(sp.shadingNormal, nFacing) < 0.0f ? -sp.shadingNormal : sp.shadingNormal;
+      bool direct = depth == 0;  // L D: shaded by shadow rays unless the map shades alone
+      if (!direct || params.storeDirect) {
+        Photon& s = out[stored++];
+        s.position = sp.position;
+        s.power = photon.power;
+        s.direction = dir;
+      }
+      float survive = fminf(1.0f, maxComponent(m.albedo));
+      if (!(rng.uniform() < survive)) break;
+      photon.power *= m.albedo * (1.0f / survive);
+      Vec3 local = sampleCosineHemisphere(rng.uniform(), rng.uniform());
+      ray.dir = Frame::fromNormal(nShade).toWorld(local);
+      if (dot(ray.dir, nFacing) <= 0.0f) break;  // shading normal sent it below the surface
+      offsetNormal = nFacing;
+    } else {
+      Vec3 throughput{1, 1, 1};
+      ray.dir = scatterSpecular(m, dir, sp.shadingNormal, rng.uniform(), throughput);
+      photon.power *= throughput;
+      offsetNormal = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
+    }
+    ray.origin = sp.position;
+  }
+  return stored;
+}
+
+}  // namespace pvr

@@ -1,0 +1,82 @@
+#pragma once
+// The host-side scene: indexed triangle meshes with per-triangle materials, the emitting
+// triangles, and the headset rig. Loaders (built-in scenes, assimp import, JSON scene files)
+// fill it; backends read it through SceneView.
+#include <string>
+#include <vector>
+
+#include "pvr/camera/stereo_rig.h"
+#include "pvr/shading/scene_view.h"
+
+namespace pvr {
+
+struct MeshRange {
+  std::string name;
+  uint32_t firstTriangle = 0;
+  uint32_t triangleCount = 0;
+};
+
+class Scene {
+ public:
+  uint32_t addMaterial(const Material& m, const std::string& name);
+  // Adds a mesh; triangles with a non-finite vertex or (near) zero area are skipped and counted
+  // in skippedTriangles(). `normals` is empty or one per vertex.
+  void addMesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
+               const std::vector<uint32_t>& indices, uint32_t materialId);
+  // Builds the light list; throws pvr::Error if nothing emits light or the scene is empty.
+  void finalize();
+
+  SceneView view() const;
+  Bounds3 bounds() const;
+  uint32_t triangleCount() const { return uint32_t(materialIds_.size()); }
+  uint32_t lightTriangleCount() const { return uint32_t(lightTriangles_.size()); }
+  uint64_t skippedTriangles() const { return skippedTriangles_; }
+  const std::vector<MeshRange>& meshes() const { return meshes_; }
+  const std::vector<Material>& materials() const { return materials_; }
+  const std::vector<std::string>& materialNames() const { return materialNames_; }
+  // Index of the mesh that holds a triangle, or -1.
+  int meshOfTriangle(uint32_t prim) const;
+  // Total emitted power (W) per channel: sum of Le * pi * area over front faces.
+  Vec3 totalLightPower() const;
+
+  const std::vector<Vec3>& vertices() const { return vertices_; }
+  const std::vector<uint32_t>& indices() const { return indices_; }
+
+  StereoRig rig = defaultRig();
+  std::string name;
+
+ private:
+  std::vector<Vec3> vertices_;
+  std::vector<Vec3> normals_;  // empty if no mesh has normals
+  std::vector<uint32_t> indices_;
+  std::vector<uint32_t> materialIds_;
+  std::vector<Material> materials_;
+  std::vector<std::string> materialNames_;
+  std::vector<MeshRange> meshes_;
+  std::vector<uint32_t> lightTriangles_;
+  std::vector<float> lightCdf_;
+  uint64_t skippedTriangles_ = 0;
+  float sceneRadius_ = 1.0f;
+};
+
+// Built-in scenes by name ("cornell", "cornell-caustics"); throws pvr::Error for an unknown name.
+Scene builtinScene(const std::string& name);
+std::vector<std::string> builtinSceneNames();
+
+// Where an imported mesh goes: scale, then rotate, then translate.
+struct ImportOptions {
+  Vec3 scale{1, 1, 1};
+  Quat rotation;
+  Vec3 translation{0, 0, 0};
+  float emissionScale = 1.0f;  ///< glTF's emissiveFactor is at most 1: scale it to a light's Le
+};
+
+// A mesh file through assimp (.gltf, .glb, .obj with .mtl, and whatever else assimp reads).
+// Appends to `scene`; throws pvr::Error for a missing, unsupported or malformed file.
+void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& options = {});
+
+// A JSON scene file (see docs/scene-format.md) or, for any other extension, a mesh file.
+// The result is finalized. Throws pvr::Error with one line naming the problem.
+Scene loadScene(const std::string& pathOrBuiltin);
+
+}  // namespace pvr

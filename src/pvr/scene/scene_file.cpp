@@ -1,0 +1,169 @@
+// JSON scene files (docs/scene-format.md): mesh files placed in the world, extra quad lights,
+// and the headset rig. Any other path is loaded as a single mesh file, or as a built-in scene.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+
+using nlohmann::json;
+
+float number(const json& j, const std::string& what) {
+  if (!j.is_number()) throw Error(what + " must be a number");
+  float v = j.get<float>();
+  if (!std::isfinite(v)) throw Error(what + " must be finite");
+  return v;
+}
+
+Vec3 vec3(const json& j, const std::string& what) {
+  if (j.is_number()) return Vec3(number(j, what));
+  if (!j.is_array() || j.size() != 3) throw Error(what + " must be an array of 3 numbers");
+  return {number(j[0], what), number(j[1], what), number(j[2], what)};
+}
+
+Fov fovDegrees(const json& j, const std::string& what) {
+  if (!j.is_array() || j.size() != 4) throw Error(what + " must be [left, right, up, down] in degrees");
+  const float deg = kPi / 180.0f;
+  Fov f{number(j[0], what) * deg, number(j[1], what) * deg, number(j[2], what) * deg, number(j[3], what) * deg};
+  auto valid = [](float lo, float hi) { return lo < hi && lo > -kPi / 2 && hi < kPi / 2; };
+  if (!valid(f.angleLeft, f.angleRight) || !valid(f.angleDown, f.angleUp))
+    throw Error(what + " must satisfy -90 < left < right < 90 and -90 < down < up < 90 degrees");
+  return f;
+}
+
+void checkKeys(const json& j, const std::string& where, std::initializer_list<const char*> known) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    bool ok = false;
+    for (const char* k : known) ok = ok || it.key() == k;
+    if (!ok) throw Error("unknown key '" + it.key() + "' in " + where);
+  }
+}
+
+void applyCamera(const json& cam, StereoRig& rig) {
+  if (!cam.is_object()) throw Error("'camera' must be an object");
+  checkKeys(cam, "'camera'", {"position", "look_at", "orientation", "ipd", "fov_deg", "fov_left_deg", "fov_right_deg", "eye_size"});
+  if (cam.contains("position")) rig.head.position = vec3(cam["position"], "camera.position");
+  if (cam.contains("look_at")) {
+    Vec3 target = vec3(cam["look_at"], "camera.look_at");
+    Vec3 forward = target - rig.head.position;
+    if (!(length(forward) > 0) || length(cross(normalize(forward), {0, 1, 0})) < 1e-4f)
+      throw Error("camera.look_at must differ from the position and not be straight up or down");
+    rig.head.orientation = lookAtOrientation(rig.head.position, target);
+  } else if (cam.contains("orientation")) {
+    const json& q = cam["orientation"];
+    if (!q.is_array() || q.size() != 4) throw Error("camera.orientation must be a quaternion [x, y, z, w]");
+    Quat o{number(q[0], "camera.orientation"), number(q[1], "camera.orientation"), number(q[2], "camera.orientation"),
+           number(q[3], "camera.orientation")};
+    float n = std::sqrt(o.x * o.x + o.y * o.y + o.z * o.z + o.w * o.w);
+    if (!(n > 1e-6f)) throw Error("camera.orientation must be a non-zero quaternion");
+    rig.head.orientation = {o.x / n, o.y / n, o.z / n, o.w / n};
+  }
+  if (cam.contains("ipd")) {
+    rig.ipd = number(cam["ipd"], "camera.ipd");
+    if (rig.ipd < 0 || rig.ipd > 1) throw Error("camera.ipd must be between 0 and 1 (metres)");
+  }
+  if (cam.contains("fov_deg")) rig.fov[0] = rig.fov[1] = fovDegrees(cam["fov_deg"], "camera.fov_deg");
+  if (cam.contains("fov_left_deg")) rig.fov[0] = fovDegrees(cam["fov_left_deg"], "camera.fov_left_deg");
+  if (cam.contains("fov_right_deg")) rig.fov[1] = fovDegrees(cam["fov_right_deg"], "camera.fov_right_deg");
+  if (cam.contains("eye_size")) {
+    const json& s = cam["eye_size"];
+    if (!s.is_array() || s.size() != 2 || !s[0].is_number_integer() || !s[1].is_number_integer())
+      throw Error("camera.eye_size must be [width, height] in pixels");
+    rig.width = s[0].get<int>();
+    rig.height = s[1].get<int>();
+  }
+}
+
+Scene loadJsonScene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot open '" + path + "'");
+  json doc;
+  try {
+    doc = json::parse(in);
+  } catch (const json::parse_error& e) {
+    std::string why = e.what();
+    throw Error("malformed JSON in '" + path + "': " + why.substr(why.find(']') + 2));
+  }
+  try {
+    if (!doc.is_object()) throw Error("the top level must be an object");
+    checkKeys(doc, "the scene file", {"base", "meshes", "lights", "camera"});
+    Scene scene;
+    if (doc.contains("base")) {
+      if (!doc["base"].is_string()) throw Error("'base' must name a built-in scene");
+      scene = builtinScene(doc["base"].get<std::string>());
+    }
+    scene.name = std::filesystem::path(path).stem().string();
+    std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    if (doc.contains("meshes")) {
+      if (!doc["meshes"].is_array()) throw Error("'meshes' must be an array");
+      for (const json& m : doc["meshes"]) {
+        if (!m.is_object() || !m.contains("file") || !m["file"].is_string())
+          throw Error("each entry of 'meshes' needs a \"file\"");
+        checkKeys(m, "a mesh entry", {"file", "scale", "rotate_deg", "translate", "emission_scale"});
+        ImportOptions opt;
+        if (m.contains("scale")) opt.scale = vec3(m["scale"], "mesh scale");
+        if (m.contains("translate")) opt.translation = vec3(m["translate"], "mesh translate");
+        if (m.contains("emission_scale")) opt.emissionScale = number(m["emission_scale"], "mesh emission_scale");
+        if (m.contains("rotate_deg")) {  // Euler angles, applied X then Y then Z
+          Vec3 r = vec3(m["rotate_deg"], "mesh rotate_deg") * (kPi / 180.0f);
+          opt.rotation = Quat::fromAxisAngle({0, 0, 1}, r.z) * Quat::fromAxisAngle({0, 1, 0}, r.y) *
+                         Quat::fromAxisAngle({1, 0, 0}, r.x);
+        }
+        std::filesystem::path file = m["file"].get<std::string>();
+        importMeshFile((file.is_absolute() ? file : dir / file).string(), scene, opt);
+      }
+    }
+    if (doc.contains("lights")) {
+      if (!doc["lights"].is_array()) throw Error("'lights' must be an array");
+      for (const json& l : doc["lights"]) {
+        if (!l.is_object()) throw Error("each light must be an object");
+        checkKeys(l, "a light", {"quad", "emission"});
+        if (!l.contains("quad") || !l["quad"].is_array() || l["quad"].size() != 4)
+          throw Error("a light needs \"quad\": four corners, counter-clockwise seen from the lit side");
+        Material m;
+        m.emission = vec3(l.value("emission", json::array({10, 10, 10})), "light emission");
+        if (m.emission.x < 0 || m.emission.y < 0 || m.emission.z < 0) throw Error("light emission must not be negative");
+        std::vector<Vec3> corners;
+        for (const json& c : l["quad"]) corners.push_back(vec3(c, "light quad corner"));
+        uint32_t id = scene.addMaterial(m, "light");
+        scene.addMesh("quad light", corners, {}, {0, 1, 2, 0, 2, 3}, id);
+      }
+    }
+    if (doc.contains("camera")) applyCamera(doc["camera"], scene.rig);
+    scene.finalize();
+    return scene;
+  } catch (const Error& e) {
+    throw Error("in '" + path + "': " + e.what());
+  } catch (const json::exception& e) {
+    throw Error("in '" + path + "': " + e.what());
+  }
+}
+
+}  // namespace
+
+Scene loadScene(const std::string& pathOrBuiltin) {
+  for (const std::string& name : builtinSceneNames())
+    if (pathOrBuiltin == name) return builtinScene(name);
+  std::filesystem::path p(pathOrBuiltin);
+  std::error_code ec;
+  if (!std::filesystem::exists(p, ec))
+    throw Error("cannot open '" + pathOrBuiltin + "': no such file or built-in scene (built-in: cornell, cornell-caustics)");
+  if (p.extension() == ".json") return loadJsonScene(pathOrBuiltin);
+  Scene scene;
+  scene.name = p.stem().string();
+  importMeshFile(pathOrBuiltin, scene);
+  scene.finalize();
+  // A bare mesh file has no camera: look at it from in front (+Z), far enough to see all of it.
+  Bounds3 b = scene.bounds();
+  Vec3 center = (b.lower + b.upper) * 0.5f;
+  scene.rig.head.position = center + Vec3(0.0f, 0.0f, 0.5f * b.extent().z + 1.2f * maxComponent(b.extent()));
+  scene.rig.head.orientation = lookAtOrientation(scene.rig.head.position, center);
+  return scene;
+}
+
+}  // namespace pvr

@@ -1,0 +1,34 @@
+#pragma once
+// Counter-based random numbers: every draw is a pure function of (seed, stream index, bounce,
+// dimension), so the CPU and CUDA backends draw identical numbers for the same photon or pixel
+// regardless of thread scheduling.
+#include "pvr/pvr.h"
+
+namespace pvr {
+
+// A 32-bit integer permutation with full avalanche (PCG's RXS-M-XS output step on an LCG step).
+PVR_HOST_DEVICE inline uint32_t hash32(uint32_t v) {
+  uint32_t state = v * 747796405u + 2891336453u;
+  uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+PVR_HOST_DEVICE inline uint32_t hashCombine(uint32_t seed, uint32_t v) { return hash32(seed ^ hash32(v)); }
+
+// Uniform float in [0, 1) from the top 24 bits.
+PVR_HOST_DEVICE inline float toUnitFloat(uint32_t bits) { return float(bits >> 8) * (1.0f / 16777216.0f); }
+
+// One random stream: a key fixed by (seed, index, bounce) and a counter for the dimension.
+class CounterRng {
+ public:
+  PVR_HOST_DEVICE CounterRng(uint32_t seed, uint32_t index, uint32_t bounce)
+      : key_(hashCombine(hashCombine(hash32(seed), index), bounce)) {}
+  PVR_HOST_DEVICE float uniform() { return toUnitFloat(hashCombine(key_, counter_++)); }
+  PVR_HOST_DEVICE uint32_t nextBits() { return hashCombine(key_, counter_++); }
+
+ private:
+  uint32_t key_;
+  uint32_t counter_ = 0;
+};
+
+}  // namespace pvr
