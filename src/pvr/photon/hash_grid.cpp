@@ -4,15 +4,23 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "pvr/util/error.h"
 
 namespace pvr {
+namespace {
+std::string formatNumber(float v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", v);
+  return buffer;
+}
+}  // namespace
 
 HashGridView hashGridLayout(const Bounds3& bounds, float radius) {
   if (!(radius > 0.0f) || !std::isfinite(radius))
-    throw Error("search radius must be a positive finite number, got " + std::to_string(radius));
+    throw Error("search radius must be a positive finite number, got " + formatNumber(radius));
   HashGridView g;
   Vec3 extent = bounds.empty() ? Vec3(0.0f) : bounds.extent();
   Vec3 lower = bounds.empty() ? Vec3(0.0f) : bounds.lower;
@@ -30,7 +38,7 @@ HashGridView hashGridLayout(const Bounds3& bounds, float radius) {
     g.dims[a] = int(n);
     cells *= uint64_t(n);
     if (cells > HashGrid::kMaxCells)
-      throw Error("search radius " + std::to_string(radius) +
+      throw Error("search radius " + formatNumber(radius) +
                   " is too small for the photons' extent: the hash grid would need more than " +
                   std::to_string(HashGrid::kMaxCells) + " cells");
   }

@@ -13,7 +13,8 @@ PVR_HOST_DEVICE inline uint32_t hash32(uint32_t v) {
   return (word >> 22u) ^ word;
 }
 
-PVR_HOST_DEVICE inline uint32_t hashCombine(uint32_t seed, uint32_t v) { return hash32(seed ^ hash32(v)); }
+// Order-dependent: hashCombine(a, b) != hashCombine(b, a), so (seed, index) never aliases (index, seed).
+PVR_HOST_DEVICE inline uint32_t hashCombine(uint32_t seed, uint32_t v) { return hash32(seed * 0x9E3779B1u + hash32(v)); }
 
 // Uniform float in [0, 1) from the top 24 bits.
 PVR_HOST_DEVICE inline float toUnitFloat(uint32_t bits) { return float(bits >> 8) * (1.0f / 16777216.0f); }

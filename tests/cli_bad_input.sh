@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Bad input through the real photonvr executable: each case must exit non-zero (not by a
+# signal), print exactly one line on stderr, and that line must name the problem.
+set -u
+exe=$1
+data=$2
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+failures=0
+small=(--eye-size 8x8 --photons 16x16 --out "$out/img")
+
+expect_error() {  # expected-substring, arguments...
+  local expected=$1
+  shift
+  "$exe" "$@" >"$out/stdout" 2>"$out/stderr"
+  local rc=$?
+  local lines
+  lines=$(wc -l <"$out/stderr")
+  if [ "$rc" -eq 0 ] || [ "$rc" -ge 128 ]; then
+    echo "FAIL ($*): exit code $rc"
+    failures=$((failures + 1))
+  elif [ "$lines" -ne 1 ]; then
+    echo "FAIL ($*): $lines lines on stderr:"
+    cat "$out/stderr"
+    failures=$((failures + 1))
+  elif ! grep -qi -- "$expected" "$out/stderr"; then
+    echo "FAIL ($*): expected '$expected' in: $(cat "$out/stderr")"
+    failures=$((failures + 1))
+  else
+    echo "ok   ($*): $(cat "$out/stderr")"
+  fi
+}
+
+expect_error "no such file" render "$data/missing.gltf" "${small[@]}"
+expect_error "unsupported scene format" render "$data/not_a_scene.txt" "${small[@]}"
+expect_error "malformed JSON" render "$data/malformed.json" "${small[@]}"
+expect_error "cannot read" render "$data/malformed.gltf" "${small[@]}"
+expect_error "no light" render "$data/no_light.obj" "${small[@]}"
+expect_error "photons must be" render cornell --photons 0 --eye-size 8x8
+expect_error "photons must be" render cornell --photons 0x256 --eye-size 8x8
+expect_error "photons" render cornell --photons -5 --eye-size 8x8
+expect_error "too large" render cornell --photons 100000x100000 --eye-size 8x8
+expect_error "radius" render cornell --radius 0 --eye-size 8x8
+expect_error "radius" render cornell --radius -0.1 --eye-size 8x8
+expect_error "radius" render cornell --radius nan --eye-size 8x8
+expect_error "radius" render cornell --radius inf --eye-size 8x8
+expect_error "radius" render cornell --radius abc --eye-size 8x8
+expect_error "eye-size" render cornell --eye-size 0x0
+expect_error "eye-size" render cornell --eye-size 100000x100000
+expect_error "eye-size" render cornell --eye-size 12
+expect_error "ipd" render cornell --ipd -1 --eye-size 8x8
+expect_error "--k" render cornell --estimator knn --k 0 --eye-size 8x8
+expect_error "--k" render cornell --estimator knn --k 65 --eye-size 8x8
+expect_error "--map" render cornell --map octree --eye-size 8x8
+expect_error "--estimator" render cornell --estimator gaussian --eye-size 8x8
+expect_error "--eyes" render cornell --eyes middle --eye-size 8x8
+expect_error "--spp" render cornell --spp 0 --eye-size 8x8
+expect_error "cannot" render cornell --eye-size 8x8 --photons 16x16 --out /dev/null/img
+expect_error "radius 1e-05 is too small" render cornell --radius 0.00001 --eye-size 8x8
+expect_error "the following argument was not expected\|extraneous\|not expected" render cornell extra-positional
+expect_error "" render cornell --no-such-option
+expect_error "" frobnicate
+expect_error "" bench cornell --k 0
+
+# NaN vertices and degenerate triangles: a warning, and the render goes on.
+"$exe" render "$data/nan_and_degenerate.obj" "${small[@]}" >"$out/stdout" 2>"$out/stderr"
+rc=$?
+if [ "$rc" -ne 0 ] || ! grep -q "skipped 2 degenerate or non-finite triangles" "$out/stderr"; then
+  echo "FAIL (nan_and_degenerate.obj): exit $rc, stderr: $(cat "$out/stderr")"
+  failures=$((failures + 1))
+else
+  echo "ok   (nan_and_degenerate.obj): $(cat "$out/stderr")"
+fi
+
+[ "$failures" -eq 0 ] && echo "all bad-input cases passed" || echo "$failures bad-input case(s) failed"
+exit $((failures > 0))

@@ -1,0 +1,123 @@
+// Scene import (glTF through assimp, OBJ/MTL, JSON scene files) with the material mapping, and
+// every bad-input case at the library level: each must throw pvr::Error with a clear message.
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "pvr/render/renderer.h"
+#include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+
+const std::string kData = PVR_TEST_DATA;
+
+const Material& materialNamed(const Scene& s, const std::string& name) {
+  for (size_t i = 0; i < s.materials().size(); ++i)
+    if (s.materialNames()[i] == name) return s.materials()[i];
+  throw std::runtime_error("no material " + name);
+}
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SceneImport, GltfMaterialsMapToPhotonvrMaterials) {
+  Scene s = loadScene(kData + "/quad_scene.gltf");
+  EXPECT_EQ(s.triangleCount(), 8u);
+  EXPECT_EQ(s.lightTriangleCount(), 2u);
+  const Material& floor = materialNamed(s, "floor");
+  EXPECT_EQ(floor.type, MaterialType::Diffuse);
+  EXPECT_EQ(floor.albedo, Vec3(0.5f, 0.25f, 0.125f));
+  EXPECT_EQ(materialNamed(s, "lamp").emission, Vec3(1.0f, 0.5f, 0.25f));
+  EXPECT_EQ(materialNamed(s, "chrome").type, MaterialType::Mirror);
+  const Material& glass = materialNamed(s, "glass");
+  EXPECT_EQ(glass.type, MaterialType::Glass);
+  EXPECT_NEAR(glass.ior, 1.45f, 1e-6f);
+}
+
+TEST(SceneImport, ObjMtlMaterialsMapToPhotonvrMaterials) {
+  Scene s = loadScene(kData + "/box.obj");
+  EXPECT_EQ(s.triangleCount(), 8u);
+  EXPECT_EQ(materialNamed(s, "white").albedo, Vec3(0.6f, 0.5f, 0.4f));
+  EXPECT_EQ(materialNamed(s, "lamp").emission, Vec3(8, 6, 4));
+  const Material& chrome = materialNamed(s, "chrome");
+  EXPECT_EQ(chrome.type, MaterialType::Mirror);
+  EXPECT_EQ(chrome.albedo, Vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_EQ(materialNamed(s, "glass").type, MaterialType::Glass);
+  EXPECT_NEAR(materialNamed(s, "glass").ior, 1.33f, 1e-6f);
+}
+
+TEST(SceneImport, JsonSceneFilePlacesMeshesAndSetsTheRig) {
+  Scene s = loadScene(kData + "/scene.json");
+  EXPECT_EQ(s.triangleCount(), 10u);
+  EXPECT_EQ(s.lightTriangleCount(), 4u);
+  EXPECT_EQ(materialNamed(s, "lamp").emission, Vec3(20.0f, 10.0f, 5.0f));  // emission_scale 20
+  Bounds3 b = s.bounds();
+  EXPECT_NEAR(b.lower.z, -2.0f, 1e-6f);  // translated by -1
+  EXPECT_NEAR(s.rig.ipd, 0.07f, 1e-7f);
+  EXPECT_EQ(s.rig.width, 64);
+  EXPECT_EQ(s.rig.height, 72);
+  EXPECT_NEAR(s.rig.fov[0].angleLeft, -50.0f * kPi / 180.0f, 1e-6f);
+  EXPECT_NEAR(s.rig.fov[1].angleRight, 50.0f * kPi / 180.0f, 1e-6f);
+  EXPECT_NEAR(s.rig.head.position.z, 1.5f, 1e-6f);
+}
+
+TEST(SceneImport, NanAndDegenerateTrianglesAreSkippedAndCounted) {
+  Scene s = loadScene(kData + "/nan_and_degenerate.obj");
+  EXPECT_EQ(s.triangleCount(), 2u);
+  EXPECT_EQ(s.skippedTriangles(), 2u);
+  Scene manual;
+  uint32_t m = manual.addMaterial(Material{}, "m");
+  manual.addMesh("bad", {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, NAN, 0}, {INFINITY, 0, 0}}, {}, {0, 1, 2, 0, 3, 1, 4, 1, 0}, m);
+  EXPECT_EQ(manual.triangleCount(), 0u);
+  EXPECT_EQ(manual.skippedTriangles(), 3u);
+  EXPECT_NE(errorOf([&] { manual.finalize(); }).find("no valid triangles"), std::string::npos);
+}
+
+TEST(SceneErrors, EachBadInputThrowsAClearError) {
+  struct Case {
+    std::string input, expected;
+  } cases[] = {
+      {kData + "/missing.obj", "no such file"},
+      {kData + "/not_a_scene.txt", "unsupported scene format '.txt'"},
+      {kData + "/malformed.json", "malformed JSON"},
+      {kData + "/malformed.gltf", "cannot read"},
+      {kData + "/no_light.obj", "has no light"},
+      {"cornel", "no such file or built-in scene"},
+  };
+  for (const Case& c : cases) {
+    std::string message = errorOf([&] { loadScene(c.input); });
+    EXPECT_NE(message.find(c.expected), std::string::npos) << c.input << " gave: '" << message << "'";
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line";
+  }
+}
+
+TEST(SceneErrors, BadRenderOptionsAreRejected) {
+  StereoRig rig = defaultRig();
+  auto check = [&](const std::function<void(RenderOptions&, StereoRig&)>& mutate, const std::string& expected) {
+    RenderOptions o;
+    StereoRig r = rig;
+    mutate(o, r);
+    std::string message = errorOf([&] { validateOptions(o, r); });
+    EXPECT_NE(message.find(expected), std::string::npos) << "got: '" << message << "'";
+  };
+  check([](RenderOptions& o, StereoRig&) { o.photonsX = 0; }, "photons must be positive");
+  check([](RenderOptions& o, StereoRig&) { o.gather.density.radius = 0; }, "radius");
+  check([](RenderOptions& o, StereoRig&) { o.gather.density.radius = -1; }, "radius");
+  check([](RenderOptions& o, StereoRig&) { o.gather.density.radius = NAN; }, "radius");
+  check([](RenderOptions& o, StereoRig&) { o.gather.density.radius = INFINITY; }, "radius");
+  check([](RenderOptions& o, StereoRig&) { o.gather.density.estimator = Estimator::Knn, o.gather.density.k = 65; }, "k must");
+  check([](RenderOptions&, StereoRig& r) { r.width = 0; }, "eye size");
+  check([](RenderOptions&, StereoRig& r) { r.height = 100000; }, "eye size");
+  check([](RenderOptions&, StereoRig& r) { r.ipd = NAN; }, "IPD");
+}
+
+}  // namespace
+}  // namespace pvr
