@@ -44,7 +44,9 @@ void expectSameAsBruteForce(const std::vector<Photon>& photons, float r, const s
     ASSERT_EQ(mapSearch(grid.view(), grid.sortedToInput(), q, r), expected) << "hash grid at " << q.x << "," << q.y << "," << q.z;
     ASSERT_EQ(mapSearch(tree.view(), tree.nodeToInput(), q, r), expected) << "kd-tree at " << q.x << "," << q.y << "," << q.z;
   }
-  if (!photons.empty()) EXPECT_GT(nonEmpty, 0u) << "the test's queries found nothing: it checks nothing";
+  if (!photons.empty()) {
+    EXPECT_GT(nonEmpty, 0u) << "the test's queries found nothing: it checks nothing";
+  }
 }
 
 Photon photonAt(Vec3 p) { return {p, {1, 1, 1}, {0, -1, 0}}; }
@@ -171,8 +173,11 @@ TEST(PhotonMaps, KdTreeIsACompleteBalancedSplitTree) {
                                                                          float split, bool left) {
     if (node >= v.photonCount) return;
     float c = v.photons[node].position[axis];
-    if (left) ASSERT_LE(c, split);
-    else ASSERT_GE(c, split);
+    if (left) {
+      ASSERT_LE(c, split);
+    } else {
+      ASSERT_GE(c, split);
+    }
     check(2 * node + 1, root, axis, split, left);
     check(2 * node + 2, root, axis, split, left);
   };

@@ -12,7 +12,7 @@ struct Vec2 {
 
 struct Vec3 {
   float x = 0, y = 0, z = 0;
-  PVR_HOST_DEVICE constexpr Vec3() = default;
+  constexpr Vec3() = default;
   PVR_HOST_DEVICE constexpr Vec3(float a, float b, float c) : x(a), y(b), z(c) {}
   PVR_HOST_DEVICE explicit constexpr Vec3(float s) : x(s), y(s), z(s) {}
   PVR_HOST_DEVICE float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
