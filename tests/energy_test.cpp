@@ -3,27 +3,38 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <array>
+#include <functional>
+
 #include "pvr/cpu/cpu_backend.h"
 
 namespace pvr {
 namespace {
 
+// Sum, in double, of the power of `count` emitted photons; `each` also sees every photon.
+std::array<double, 3> emittedPower(const Scene& scene, uint32_t count,
+                                   const std::function<void(const Photon&)>& each = {}) {
+  PhotonTraceParams params;
+  params.photonCount = count;
+  SceneView view = scene.view();
+  std::array<double, 3> sum = {0, 0, 0};
+  for (uint32_t i = 0; i < count; ++i) {
+    Photon p = emitPhoton(view, params, i);
+    if (each) each(p);
+    for (int c = 0; c < 3; ++c) sum[c] += p.power[c];
+  }
+  return sum;
+}
+
 TEST(PhotonEnergy, EmittedPhotonsCarryExactlyTheLightPower) {
   Scene scene = builtinScene("cornell");
-  SceneView view = scene.view();
-  PhotonTraceParams params;
-  params.photonCount = 100000;
+  const uint32_t n = 100000;
   Vec3 total = scene.totalLightPower();
-  double sum[3] = {0, 0, 0};
-  for (uint32_t i = 0; i < params.photonCount; ++i) {
-    Photon p = emitPhoton(view, params, i);
+  auto sum = emittedPower(scene, n, [&](const Photon& p) {
     // One light colour: every photon carries exactly Phi / N.
-    for (int c = 0; c < 3; ++c) {
-      ASSERT_NEAR(p.power[c], total[c] / params.photonCount, 1e-5 * total[c] / params.photonCount);
-      sum[c] += p.power[c];
-    }
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(p.power[c], total[c] / n, 1e-5 * total[c] / n);
     ASSERT_NEAR(length(p.direction), 1.0f, 1e-5f);
-  }
+  });
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], total[c], 1e-4 * total[c]);
   // The Cornell light: Le = (17, 12, 4) over 130 x 105 mm, scaled by 1/556.
   float area = (130.0f / 556.0f) * (105.0f / 556.0f);
@@ -40,14 +51,7 @@ TEST(PhotonEnergy, LightsOfDifferentColoursSumToTheirPower) {
   scene.addMesh("blue light", {{-0.4f, 0.9f, -0.4f}, {-0.2f, 0.9f, -0.4f}, {-0.2f, 0.9f, -0.2f}, {-0.4f, 0.9f, -0.2f}}, {},
                 {0, 1, 2, 0, 2, 3}, id);
   scene.finalize();
-  PhotonTraceParams params;
-  params.photonCount = 400000;
-  SceneView view = scene.view();
-  double sum[3] = {0, 0, 0};
-  for (uint32_t i = 0; i < params.photonCount; ++i) {
-    Photon p = emitPhoton(view, params, i);
-    for (int c = 0; c < 3; ++c) sum[c] += p.power[c];
-  }
+  auto sum = emittedPower(scene, 400000);
   Vec3 total = scene.totalLightPower();
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], total[c], 0.01 * total[c]) << "channel " << c;
 }
