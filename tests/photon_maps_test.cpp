@@ -169,7 +169,7 @@ TEST(PhotonMaps, KdTreeIsACompleteBalancedSplitTree) {
   std::set<uint32_t> inputs(tree.nodeToInput().begin(), tree.nodeToInput().end());
   EXPECT_EQ(inputs.size(), photons.size());
   // Every node splits its subtree: left descendants <= split <= right descendants.
-  std::function<void(uint32_t, uint32_t, int, float, bool)> check = [&](uint32_t node, uint32_t root, int axis,
+  std::function<void(uint32_t, int, float, bool)> check = [&](uint32_t node, int axis,
                                                                          float split, bool left) {
     if (node >= v.photonCount) return;
     float c = v.photons[node].position[axis];
@@ -178,13 +178,13 @@ TEST(PhotonMaps, KdTreeIsACompleteBalancedSplitTree) {
     } else {
       ASSERT_GE(c, split);
     }
-    check(2 * node + 1, root, axis, split, left);
-    check(2 * node + 2, root, axis, split, left);
+    check(2 * node + 1, axis, split, left);
+    check(2 * node + 2, axis, split, left);
   };
   for (uint32_t node = 0; node < v.photonCount; ++node) {
     float split = v.photons[node].position[v.axes[node]];
-    check(2 * node + 1, node, v.axes[node], split, true);
-    check(2 * node + 2, node, v.axes[node], split, false);
+    check(2 * node + 1, v.axes[node], split, true);
+    check(2 * node + 2, v.axes[node], split, false);
   }
   EXPECT_EQ(v.axes[0], 0) << "the root splits the longest axis (x)";
 }
