@@ -5,9 +5,12 @@
 #include <filesystem>
 #include <iostream>
 #include <new>
+#include <memory>
 #include <regex>
 
+#include "frame_bench.h"
 #include "map_bench.h"
+#include "pvr/render/image.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
@@ -46,6 +49,8 @@ struct RenderArgs {
   std::string radius = "0.05";
   std::string map = "hashgrid";
   std::string estimator = "radius";
+  std::string kernel = "hybrid";
+  std::string backend = "auto";
   int k = 32;
   std::string eyes = "both";
   std::string eyeSize;  // empty: the scene's rig (1440x1600 for built-in scenes)
@@ -68,6 +73,12 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--estimator", a.estimator, "Density estimation: radius (fixed radius, no heap) | knn (max-heap)")
       ->capture_default_str();
   cmd.add_option("--k", a.k, "Photons per kNN estimate (1..64)")->capture_default_str();
+  cmd.add_option("--kernel", a.kernel,
+                 "GPU eye pass: single (rays + estimate in one kernel) | hybrid (separate density kernel) | shared "
+                 "(hybrid, the paper's Algorithm 1) | sorted (hybrid, gather points sorted by cell); same image")
+      ->capture_default_str();
+  cmd.add_option("--backend", a.backend, "cpu (Embree + TBB reference) | cuda | auto (cuda if a GPU is present)")
+      ->capture_default_str();
   cmd.add_option("--seed", a.seed, "Seed of the counter-based random numbers")->capture_default_str();
   cmd.add_option("--photon-depth", a.photonDepth, "Maximum surface interactions per photon path")->capture_default_str();
 }
@@ -90,6 +101,11 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   else throw Error("--estimator must be radius or knn, got '" + a.estimator + "'");
   if (a.k < 1 || a.k > kMaxKnn) throw Error("--k must be between 1 and " + std::to_string(kMaxKnn));
   o.gather.density.k = a.k;
+  if (a.kernel == "single") o.kernel = DensityKernel::Single;
+  else if (a.kernel == "hybrid") o.kernel = DensityKernel::Hybrid;
+  else if (a.kernel == "shared") o.kernel = DensityKernel::SharedMemory;
+  else if (a.kernel == "sorted") o.kernel = DensityKernel::CellSorted;
+  else throw Error("--kernel must be single, hybrid, shared or sorted, got '" + a.kernel + "'");
   if (a.eyes == "both") o.eyes[0] = o.eyes[1] = true;
   else if (a.eyes == "left") o.eyes[0] = true, o.eyes[1] = false;
   else if (a.eyes == "right") o.eyes[0] = false, o.eyes[1] = true;
@@ -119,26 +135,39 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   return o;
 }
 
+BackendKind parseBackend(const std::string& text) {
+  if (text == "cpu") return BackendKind::Cpu;
+  if (text == "cuda") return BackendKind::Cuda;
+  if (text == "auto") return BackendKind::Auto;
+  throw Error("--backend must be cpu, cuda or auto, got '" + text + "'");
+}
+
 int runRender(const RenderArgs& a) {
+  BackendKind backendKind = parseBackend(a.backend);
   Scene scene = loadScene(a.scene);
   StereoRig rig = scene.rig;
   RenderOptions options = toOptions(a, rig);
   if (scene.skippedTriangles() > 0)
     std::cerr << "photonvr: warning: skipped " << scene.skippedTriangles()
               << " degenerate or non-finite triangles\n";
-  CpuBackend backend(scene);
+  std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(backendKind, scene);
   std::printf("scene %s: %u triangles, %u emitting; eyes %dx%d, IPD %.1f mm\n", scene.name.c_str(),
               scene.triangleCount(), scene.lightTriangleCount(), rig.width, rig.height, rig.ipd * 1000.0f);
-  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, seed %u, backend cpu\n", options.photonsX,
+  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, seed %u\n", options.photonsX,
               options.photonsY, options.gather.density.radius, a.map.c_str(), a.estimator.c_str(),
               options.gather.density.estimator == Estimator::Knn ? (" (k=" + std::to_string(a.k) + ")").c_str() : "",
               options.gather.samplesPerPixel, options.gather.seed);
-  FrameResult frame = renderFrame(backend, rig, options);
+  std::printf("backend %s: %s%s\n", renderer->name().c_str(), renderer->deviceName().c_str(),
+              renderer->name() == "cuda" ? (", " + std::string(densityKernelName(options.kernel)) + " kernel").c_str() : "");
+  FrameResult frame = renderer->render(rig, options);
   std::printf("  photon trace  %9.2f ms  (%zu photons stored)\n", frame.timings.photonTraceMs, frame.storedPhotons);
   std::printf("  map build     %9.2f ms  (%.1f MiB)\n", frame.timings.mapBuildMs, frame.mapBytes / 1048576.0);
   const char* names[2] = {"left", "right"};
   for (int e = 0; e < 2; ++e)
-    if (options.eyes[e]) std::printf("  %-5s eye     %9.2f ms\n", names[e], frame.timings.eyeMs[e]);
+    if (options.eyes[e])
+      std::printf("  %-5s eye     %9.2f ms  (eye rays %.2f, density %.2f)\n", names[e], frame.timings.eyeMs[e],
+                  frame.timings.eyeRayMs[e], frame.timings.densityMs[e]);
+  if (frame.deviceBytes) std::printf("  GPU memory    %9.1f MiB\n", frame.deviceBytes / 1048576.0);
   std::printf("  total         %9.2f ms\n", frame.timings.totalMs());
   std::filesystem::path prefix(a.out);
   if (prefix.has_parent_path()) std::filesystem::create_directories(prefix.parent_path());
@@ -156,14 +185,14 @@ int runRender(const RenderArgs& a) {
 }  // namespace
 
 int runCli(int argc, char** argv) {
-  CLI::App app{"photonvr: real-time photon mapping for VR headsets (CPU reference backend: Embree + TBB)"};
+  CLI::App app{"photonvr: real-time photon mapping for VR headsets (CUDA backend, and the CPU reference: Embree + TBB)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "photonvr 0.1.0");
 
   RenderArgs ra;
   CLI::App* render = app.add_subcommand("render", "Render a stereo pair of a scene to PNG (sRGB) and EXR (linear)");
   render->footer(
-      "Scenes: a built-in name (cornell, cornell-caustics), a JSON scene file (docs/scene-format.md), or a mesh file\n"
+      "Scenes: a built-in name (cornell, cornell-caustics, cornell-dense), a JSON scene file (docs/scene-format.md), or a mesh file\n"
       "(.gltf, .glb, .obj+.mtl via assimp). Materials: base colour -> diffuse, emissive -> area light,\n"
       "metallic + smooth -> mirror, transmission / ior -> glass. Textures are not supported yet: only constant\n"
       "material factors are used.\n"
@@ -185,21 +214,38 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
 
   MapBenchArgs ba;
-  CLI::App* bench = app.add_subcommand("bench", "Benchmark photon maps on the CPU: kd-tree vs hash grid, build and "
-                                                "query, radius sum vs kNN, on the paper's grid of photons and radii");
-  bench->add_option("scene", ba.scene, "Scene whose photons and eye hit points are used")->capture_default_str();
-  bench->add_option("--photons", ba.photons, "Comma-separated photon grids")->capture_default_str();
-  bench->add_option("--radii", ba.radii, "Comma-separated search radii")->capture_default_str();
-  bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye")
+  FrameBenchArgs fa;
+  CLI::App* bench = app.add_subcommand(
+      "bench", "Benchmarks that check their own results: the paper's Tables 1-4 as whole stereo frames (tables), "
+               "CUDA ray throughput (rays), GPU hash-grid build (grid), CPU photon-map queries (maps)");
+  bench->add_option("scene", ba.scene, "Scene for the tables, grid and maps suites")->capture_default_str();
+  bench->add_option("--suite", fa.suite, "tables | rays | grid | all (tables, rays, grid) | maps (CPU map queries)")
+      ->capture_default_str();
+  bench->add_option("--backend", fa.backend, "Backend of the tables suite: cpu | cuda | auto")->capture_default_str();
+  bench->add_option("--tables", fa.tables, "Paper tables to run (tables suite)")->capture_default_str();
+  bench->add_option("--frames", fa.frames, "Frames averaged per cell (tables suite)")->capture_default_str();
+  bench->add_option("--warmup", fa.warmup, "Warm-up frames per cell (tables suite)")->capture_default_str();
+  bench->add_option("--eye-size", fa.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
+  bench->add_option("--rays-scenes", fa.raysScene, "Scenes of the rays suite")->capture_default_str();
+  bench->add_option("--photons", ba.photons, "Comma-separated photon grids (maps suite)")->capture_default_str();
+  bench->add_option("--radii", ba.radii, "Comma-separated search radii (maps suite)")->capture_default_str();
+  bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye (maps suite)")
       ->capture_default_str();
   bench->add_option("--k", ba.k, "Photons per kNN query")->capture_default_str();
-  bench->add_option("--repeats", ba.repeats, "Timed repetitions (the minimum is reported)")->capture_default_str();
+  bench->add_option("--repeats", ba.repeats, "Timed repetitions, the minimum is reported (maps suite)")
+      ->capture_default_str();
   bench->add_option("--json", ba.json, "Also write the results as JSON to this file");
 
   try {
     app.parse(argc, argv);
     if (render->parsed()) return runRender(ra);
-    if (bench->parsed()) return runMapBench(ba);
+    if (bench->parsed()) {
+      if (fa.suite == "maps") return runMapBench(ba);
+      fa.scene = ba.scene;
+      fa.k = ba.k;
+      fa.json = ba.json;
+      return runFrameBench(fa);
+    }
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

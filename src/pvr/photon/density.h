@@ -17,6 +17,20 @@ struct DensityParams {
   int k = 32;  ///< photons for kNN, 1..kMaxKnn
 };
 
+// A photon counts towards a surface only if it arrived from the side the normal faces.
+PVR_HOST_DEVICE inline bool photonFacesSurface(Vec3 photonDirection, Vec3 n) { return dot(photonDirection, n) < 0.0f; }
+
+// The kNN estimate from a filled heap; with fewer than k photons in reach the estimate's support
+// is the whole maximum radius (r2).
+template <class PhotonMap>
+PVR_HOST_DEVICE Vec3 knnFluxDensity(const PhotonMap& map, const KnnHeap& heap, float r2) {
+  if (heap.size == 0) return {0, 0, 0};
+  Vec3 sum{0, 0, 0};
+  for (int j = 0; j < heap.size; ++j) sum += map.photons[heap.index[j]].power;
+  float area = kPi * (heap.full() ? heap.maxDist2() : r2);
+  return area > 0.0f ? sum * (1.0f / area) : Vec3{0, 0, 0};
+}
+
 // Irradiance-like flux density sum(dPhi) / (pi r^2) at x on a surface with unit normal n facing
 // the viewer; photons that arrived from behind the surface are ignored. Multiply by the diffuse
 // BRDF (albedo / pi) for radiance.
@@ -27,20 +41,15 @@ PVR_HOST_DEVICE Vec3 estimateFluxDensity(const PhotonMap& map, Vec3 x, Vec3 n, c
     Vec3 sum{0, 0, 0};
     map.search(x, r2, [&](uint32_t i, float, float&) {
       const Photon& p = map.photons[i];
-      if (dot(p.direction, n) < 0.0f) sum += p.power;
+      if (photonFacesSurface(p.direction, n)) sum += p.power;
     });
     return sum * (1.0f / (kPi * r2));
   }
   KnnHeap heap(params.k);
   map.search(x, r2, [&](uint32_t i, float d2, float& searchR2) {
-    if (dot(map.photons[i].direction, n) < 0.0f) heap.offer(d2, i, searchR2);
+    if (photonFacesSurface(map.photons[i].direction, n)) heap.offer(d2, i, searchR2);
   });
-  if (heap.size == 0) return {0, 0, 0};
-  Vec3 sum{0, 0, 0};
-  for (int j = 0; j < heap.size; ++j) sum += map.photons[heap.index[j]].power;
-  // Fewer than k photons in reach: the estimate's support is the whole maximum radius.
-  float area = kPi * (heap.full() ? heap.maxDist2() : r2);
-  return area > 0.0f ? sum * (1.0f / area) : Vec3{0, 0, 0};
+  return knnFluxDensity(map, heap, params.radius * params.radius);
 }
 
 }  // namespace pvr

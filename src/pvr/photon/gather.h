@@ -29,10 +29,24 @@ struct PixelSample {
   uint32_t firstPrim = ~0u;  ///< triangle seen first by the pixel's centre sample, ~0u for none
 };
 
-template <class Intersector, class PhotonMap>
-PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
-                                      const GatherParams& params, Ray ray, CounterRng& rng, uint32_t* firstPrim) {
-  Vec3 radiance{0, 0, 0}, throughput{1, 1, 1};
+// Where an eye path meets its first diffuse surface, with everything gathered on the way except
+// the photon-map estimate there: radiance = emitted + direct light, and the estimate still to add
+// is weight * estimateFluxDensity(position, normal). Splitting here is what lets the GPU trace eye
+// rays in one kernel and estimate densities in another (the paper's hybrid scheme).
+struct GatherPoint {
+  Vec3 radiance{0, 0, 0};
+  Vec3 weight{0, 0, 0};  ///< throughput * albedo / pi; zero when the path found no diffuse surface
+  Vec3 position{0, 0, 0};
+  Vec3 normal{0, 0, 0};  ///< geometric normal facing the arriving ray
+  PVR_HOST_DEVICE bool needsEstimate() const { return !isBlack(weight); }
+};
+
+// Follows the eye ray through mirrors and glass to the first diffuse surface.
+template <class Intersector>
+PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Intersector& intersector,
+                                           const GatherParams& params, Ray ray, CounterRng& rng, uint32_t* firstPrim) {
+  GatherPoint out;
+  Vec3 throughput{1, 1, 1};
   float eps = scene.rayEpsilon();
   for (int depth = 0; depth <= params.maxSpecularDepth; ++depth) {
     Hit hit;
@@ -41,7 +55,7 @@ PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector&
     SurfacePoint sp = scene.surfacePoint(hit);
     const Material& m = scene.materials[sp.materialId];
     bool front = dot(ray.dir, sp.geometricNormal) < 0.0f;
-    if (front && m.isEmissive()) radiance += throughput * m.emission;
+    if (front && m.isEmissive()) out.radiance += throughput * m.emission;
     if (m.type == MaterialType::Diffuse) {
       Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
       Vec3 nShade = front ? sp.shadingNormal : -sp.shadingNormal;
@@ -57,17 +71,43 @@ PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector&
         if (cosSurface > 0.0f && cosLight > 0.0f && dot(nGeo, wi) > 0.0f) {
           Ray shadow{sp.position + nGeo * eps, wi};
           if (!intersector.occluded(shadow, dist * (1.0f - 1e-3f) - eps))
-            radiance += throughput * brdf * ls.emission * (cosSurface * cosLight / (dist2 * ls.pdfArea));
+            out.radiance += throughput * brdf * ls.emission * (cosSurface * cosLight / (dist2 * ls.pdfArea));
         }
       }
-      radiance += throughput * brdf * estimateFluxDensity(map, sp.position, nGeo, params.density);
+      out.weight = throughput * brdf;
+      out.position = sp.position;
+      out.normal = nGeo;
       break;
     }
     ray.dir = scatterSpecular(m, ray.dir, sp.shadingNormal, rng.uniform(), throughput);
     Vec3 side = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
     ray.origin = sp.position + side * eps;
   }
-  return radiance;
+  return out;
+}
+
+// Adds the photon-map estimate at the gather point.
+template <class PhotonMap>
+PVR_HOST_DEVICE Vec3 finishGather(const PhotonMap& map, const GatherPoint& point, const DensityParams& density) {
+  if (!point.needsEstimate()) return point.radiance;
+  return point.radiance + point.weight * estimateFluxDensity(map, point.position, point.normal, density);
+}
+
+template <class Intersector, class PhotonMap>
+PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
+                                      const GatherParams& params, Ray ray, CounterRng& rng, uint32_t* firstPrim) {
+  return finishGather(map, traceToDiffuse(scene, intersector, params, ray, rng, firstPrim), params.density);
+}
+
+// The camera ray of sample s of pixel (x, y), with the random numbers that continue its path. The
+// first sample goes through the pixel centre, so the first-hit id is stable.
+PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
+                                          int s, CounterRng& rng) {
+  uint32_t pixelIndex = uint32_t(y) * uint32_t(camera.width) + uint32_t(x);
+  uint32_t eyeSeed = hashCombine(params.seed, 0x51ed270bu + uint32_t(eye));
+  rng = CounterRng(eyeSeed, pixelIndex, uint32_t(s));
+  float jx = s == 0 ? 0.5f : rng.uniform(), jy = s == 0 ? 0.5f : rng.uniform();
+  return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 
 // Radiance of pixel (x, y) of one eye: the average of samplesPerPixel jittered rays.
@@ -75,13 +115,9 @@ template <class Intersector, class PhotonMap>
 PVR_HOST_DEVICE PixelSample shadePixel(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
                                        const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y) {
   PixelSample out;
-  uint32_t pixelIndex = uint32_t(y) * uint32_t(camera.width) + uint32_t(x);
-  uint32_t eyeSeed = hashCombine(params.seed, 0x51ed270bu + uint32_t(eye));
   for (int s = 0; s < params.samplesPerPixel; ++s) {
-    CounterRng rng(eyeSeed, pixelIndex, uint32_t(s));
-    // The first sample goes through the pixel centre, so the first-hit id is stable.
-    float jx = s == 0 ? 0.5f : rng.uniform(), jy = s == 0 ? 0.5f : rng.uniform();
-    Ray ray = camera.generateRay(float(x) + jx, float(y) + jy);
+    CounterRng rng(0, 0, 0);
+    Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
     out.radiance += radianceAlongRay(scene, intersector, map, params, ray, rng, s == 0 ? &out.firstPrim : nullptr);
   }
   out.radiance *= 1.0f / float(params.samplesPerPixel);

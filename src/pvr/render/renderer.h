@@ -1,45 +1,20 @@
 #pragma once
-// One stereo frame: trace photons, build the photon map, shade the requested eyes, with the
-// time of every stage. Backend-neutral options; the CPU backend is the reference.
+// Choosing a backend: the CPU reference (Embree + TBB) or CUDA.
+#include <memory>
 #include <string>
-#include <vector>
 
-#include "pvr/cpu/cpu_backend.h"
-#include "pvr/render/image.h"
+#include "pvr/cpu/cpu_renderer.h"
+#include "pvr/frame/frame.h"
 
 namespace pvr {
 
-enum class PhotonMapKind : int { HashGrid = 0, KdTree = 1 };
+enum class BackendKind : int { Cpu = 0, Cuda = 1, Auto = 2 };
 
-struct RenderOptions {
-  uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
-  int maxPhotonDepth = 8;
-  PhotonMapKind map = PhotonMapKind::HashGrid;
-  GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
-  bool eyes[2] = {true, true};
-  uint32_t photonCount() const { return photonsX * photonsY; }
-};
+// True if this build has the CUDA backend and a CUDA GPU is usable; otherwise `why` says why not.
+bool cudaBackendAvailable(std::string* why = nullptr);
 
-struct StageTimings {
-  double photonTraceMs = 0, mapBuildMs = 0, eyeMs[2] = {0, 0};
-  double totalMs() const { return photonTraceMs + mapBuildMs + eyeMs[0] + eyeMs[1]; }
-};
-
-struct EyeResult {
-  Image image;
-  std::vector<uint32_t> firstPrim;  ///< per pixel, the triangle its centre ray hit first (~0u: none)
-};
-
-struct FrameResult {
-  EyeResult eyes[2];
-  StageTimings timings;
-  size_t storedPhotons = 0;
-  size_t mapBytes = 0;
-};
-
-// Checks options against the scene and the rig; throws pvr::Error naming the bad value.
-void validateOptions(const RenderOptions& options, const StereoRig& rig);
-
-FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const RenderOptions& options);
+// The renderer for `kind` (Auto: CUDA if available, else CPU). Throws pvr::Error for Cuda when
+// no GPU can be used.
+std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& scene);
 
 }  // namespace pvr

@@ -56,9 +56,35 @@ void addSphere(Scene& scene, const std::string& name, Vec3 center, float radius,
   scene.addMesh(name, v, n, idx, material);
 }
 
-Scene cornellBox(bool caustics) {
+// A sphere with a sinusoidal relief on a fine latitude-longitude grid: many small triangles of
+// varied orientation, for measuring ray throughput on over a million triangles.
+void addBumpySphere(Scene& scene, const std::string& name, Vec3 centre, float radius, int segments, int rings,
+                    uint32_t material) {
+  std::vector<Vec3> v;
+  std::vector<uint32_t> idx;
+  v.reserve(size_t(segments + 1) * (rings + 1));
+  for (int j = 0; j <= rings; ++j) {
+    float theta = kPi * float(j) / float(rings);
+    for (int i = 0; i <= segments; ++i) {
+      float phi = 2.0f * kPi * float(i) / float(segments);
+      float r = radius * (1.0f + 0.06f * sinf(12.0f * theta) * sinf(10.0f * phi));
+      v.push_back(centre + Vec3(r * sinf(theta) * cosf(phi), r * cosf(theta), r * sinf(theta) * sinf(phi)));
+    }
+  }
+  for (int j = 0; j < rings; ++j)
+    for (int i = 0; i < segments; ++i) {
+      uint32_t a = uint32_t(j * (segments + 1) + i), b = a + 1, c = a + uint32_t(segments + 1), d = c + 1;
+      idx.insert(idx.end(), {a, b, c, b, d, c});
+    }
+  scene.addMesh(name, v, {}, idx, material);
+}
+
+enum class CornellContents { Blocks, Spheres, DenseSphere };
+
+Scene cornellBox(CornellContents contents) {
   Scene scene;
-  scene.name = caustics ? "cornell-caustics" : "cornell";
+  bool caustics = contents == CornellContents::Spheres;
+  scene.name = caustics ? "cornell-caustics" : (contents == CornellContents::Blocks ? "cornell" : "cornell-dense");
   Material white, red, green, light;
   white.albedo = {0.73f, 0.73f, 0.73f};
   red.albedo = {0.63f, 0.065f, 0.05f};
@@ -83,7 +109,9 @@ Scene cornellBox(bool caustics) {
   addQuad(scene, "light", cornell(343, 548.3f, 227), cornell(343, 548.3f, 332), cornell(213, 548.3f, 332),
           cornell(213, 548.3f, 227), mLight);
 
-  if (!caustics) {
+  if (contents == CornellContents::DenseSphere) {
+    addBumpySphere(scene, "bumpy sphere", {0.0f, 0.3f, -0.05f}, 0.26f, 1024, 640, mWhite);
+  } else if (!caustics) {
     const Vec3 shortTop[4] = {cornell(130, 165, 65), cornell(82, 165, 225), cornell(240, 165, 272), cornell(290, 165, 114)};
     const Vec3 tallTop[4] = {cornell(423, 330, 247), cornell(265, 330, 296), cornell(314, 330, 456), cornell(472, 330, 406)};
     addBlock(scene, "short block", shortTop, 165.0f / 556.0f, mWhite);
@@ -111,12 +139,13 @@ Scene cornellBox(bool caustics) {
 
 }  // namespace
 
-std::vector<std::string> builtinSceneNames() { return {"cornell", "cornell-caustics"}; }
+std::vector<std::string> builtinSceneNames() { return {"cornell", "cornell-caustics", "cornell-dense"}; }
 
 Scene builtinScene(const std::string& name) {
-  if (name == "cornell") return cornellBox(false);
-  if (name == "cornell-caustics") return cornellBox(true);
-  throw Error("unknown built-in scene '" + name + "' (built-in scenes: cornell, cornell-caustics)");
+  if (name == "cornell") return cornellBox(CornellContents::Blocks);
+  if (name == "cornell-caustics") return cornellBox(CornellContents::Spheres);
+  if (name == "cornell-dense") return cornellBox(CornellContents::DenseSphere);
+  throw Error("unknown built-in scene '" + name + "' (built-in scenes: cornell, cornell-caustics, cornell-dense)");
 }
 
 }  // namespace pvr

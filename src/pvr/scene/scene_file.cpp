@@ -152,7 +152,7 @@ Scene loadScene(const std::string& pathOrBuiltin) {
   std::filesystem::path p(pathOrBuiltin);
   std::error_code ec;
   if (!std::filesystem::exists(p, ec))
-    throw Error("cannot open '" + pathOrBuiltin + "': no such file or built-in scene (built-in: cornell, cornell-caustics)");
+    throw Error("cannot open '" + pathOrBuiltin + "': no such file or built-in scene (built-in: cornell, cornell-caustics, cornell-dense)");
   if (p.extension() == ".json") return loadJsonScene(pathOrBuiltin);
   Scene scene;
   scene.name = p.stem().string();

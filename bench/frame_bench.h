@@ -1,0 +1,29 @@
+#pragma once
+// `photonvr bench` suites that time whole frames and the GPU's building blocks:
+//  - tables: the main paper's Tables 1-4 (kd-tree vs hash grid, heap vs no heap, single vs
+//    hybrid kernel, with vs without shared memory), every cell a full stereo frame (photons
+//    traced, map built, both eyes shaded) averaged over many frames after warm-up;
+//  - rays: rays per second of the CUDA traversal (primary, shadow, diffuse);
+//  - grid: the hash-grid build of 1M photons on the GPU.
+// Every suite checks its own results and says which GPU, resolution, photons and radius it ran.
+#include <string>
+
+namespace pvr {
+
+struct FrameBenchArgs {
+  std::string suite = "tables";  ///< tables | rays | grid | all
+  std::string scene = "cornell";
+  std::string raysScene = "cornell,cornell-dense";
+  std::string backend = "auto";
+  std::string tables = "1,2,3,4";
+  std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
+  int frames = 100;
+  int warmup = 10;
+  int k = 32;
+  std::string json;
+};
+
+// Returns 0, or 1 if a self-check failed.
+int runFrameBench(const FrameBenchArgs& args);
+
+}  // namespace pvr

@@ -1,0 +1,259 @@
+#include "pvr/accel/bvh.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <string>
+
+#include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+
+// Embree's builder calls back into these while building in parallel; nodes live in its
+// thread-local allocator until the BVH is released, after we have flattened them.
+struct BuildNode {
+  bool leaf;
+};
+struct BuildInner : BuildNode {
+  BuildNode* children[2];
+  Bounds3 bounds[2];
+};
+struct BuildLeaf : BuildNode {
+  uint32_t count;
+  uint32_t prims[1];  // `count` entries, allocated in place
+};
+
+struct BuildInput {
+  const std::vector<Vec3>* vertices;
+  const std::vector<uint32_t>* indices;
+};
+
+constexpr unsigned kMaxLeafSize = 4;
+constexpr unsigned kMaxDepth = 48;  // below the traversal stack's 64 entries
+
+void* createInner(RTCThreadLocalAllocator alloc, unsigned int childCount, void*) {
+  auto* node = static_cast<BuildInner*>(rtcThreadLocalAlloc(alloc, sizeof(BuildInner), 16));
+  node->leaf = false;
+  node->children[0] = node->children[1] = nullptr;
+  return node;
+}
+
+void setChildren(void* nodePtr, void** children, unsigned int childCount, void*) {
+  auto* node = static_cast<BuildInner*>(nodePtr);
+  for (unsigned i = 0; i < childCount && i < 2; ++i) node->children[i] = static_cast<BuildNode*>(children[i]);
+}
+
+void setBounds(void* nodePtr, const RTCBounds** bounds, unsigned int childCount, void*) {
+  auto* node = static_cast<BuildInner*>(nodePtr);
+  for (unsigned i = 0; i < childCount && i < 2; ++i) {
+    node->bounds[i].lower = {bounds[i]->lower_x, bounds[i]->lower_y, bounds[i]->lower_z};
+    node->bounds[i].upper = {bounds[i]->upper_x, bounds[i]->upper_y, bounds[i]->upper_z};
+  }
+}
+
+void* createLeaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count, void*) {
+  size_t bytes = sizeof(BuildLeaf) + sizeof(uint32_t) * (count > 0 ? count - 1 : 0);
+  auto* leaf = static_cast<BuildLeaf*>(rtcThreadLocalAlloc(alloc, bytes, 16));
+  leaf->leaf = true;
+  leaf->count = uint32_t(count);
+  for (size_t i = 0; i < count; ++i) leaf->prims[i] = prims[i].primID;
+  return leaf;
+}
+
+// Spatial split: the bounds of the two parts of the triangle clipped at `position` along
+// `dimension`, within the reference's current (possibly already clipped) bounds.
+void splitPrimitive(const RTCBuildPrimitive* prim, unsigned int dimension, float position, RTCBounds* leftOut,
+                    RTCBounds* rightOut, void* userPtr) {
+  const auto& in = *static_cast<const BuildInput*>(userPtr);
+  Vec3 v[3];
+  for (int k = 0; k < 3; ++k) v[k] = (*in.vertices)[(*in.indices)[3 * size_t(prim->primID) + k]];
+  Bounds3 left, right;
+  int d = int(dimension);
+  for (int k = 0; k < 3; ++k) {
+    Vec3 a = v[k], b = v[(k + 1) % 3];
+    if (a[d] <= position) left.extend(a);
+    if (a[d] >= position) right.extend(a);
+    if ((a[d] < position && b[d] > position) || (a[d] > position && b[d] < position)) {
+      float t = (position - a[d]) / (b[d] - a[d]);
+      Vec3 p = a + (b - a) * std::clamp(t, 0.0f, 1.0f);
+      p[d] = position;
+      left.extend(p);
+      right.extend(p);
+    }
+  }
+  Bounds3 current{{prim->lower_x, prim->lower_y, prim->lower_z}, {prim->upper_x, prim->upper_y, prim->upper_z}};
+  auto clip = [&](Bounds3 b, RTCBounds* out) {
+    b.lower = max(b.lower, current.lower);
+    b.upper = min(b.upper, current.upper);
+    out->lower_x = b.lower.x, out->lower_y = b.lower.y, out->lower_z = b.lower.z;
+    out->upper_x = b.upper.x, out->upper_y = b.upper.y, out->upper_z = b.upper.z;
+  };
+  left.upper[d] = fminf(left.upper[d], position);
+  right.lower[d] = fmaxf(right.lower[d], position);
+  clip(left, leftOut);
+  clip(right, rightOut);
+}
+
+float surfaceArea(const Bounds3& b) {
+  if (b.empty()) return 0.0f;
+  Vec3 e = b.extent();
+  return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
+class Flattener {
+ public:
+  Flattener(const BuildInput& in, std::vector<BvhNode>& nodes, std::vector<BvhTriangle>& tris, BvhBuildStats& stats)
+      : in_(in), nodes_(nodes), tris_(tris), stats_(stats) {}
+
+  void flattenRoot(const BuildNode* root, const Bounds3& rootBounds) {
+    rootArea_ = std::max(surfaceArea(rootBounds), 1e-30f);
+    nodes_.push_back({});
+    if (!root || root->leaf) {  // a one-leaf tree: the root's second child is empty
+      setChild(0, 0, root, rootBounds, 1);
+      setEmpty(0, 1);
+      stats_.sahCost = 1.0 + (root ? static_cast<const BuildLeaf*>(root)->count : 0);
+    } else {
+      stats_.sahCost = 1.0;
+      fillInner(0, static_cast<const BuildInner*>(root), 1);
+    }
+  }
+
+ private:
+  void fillInner(uint32_t index, const BuildInner* node, uint32_t depth) {
+    stats_.maxDepth = std::max(stats_.maxDepth, depth);
+    for (int c = 0; c < 2; ++c) {
+      if (node->children[c]) setChild(index, c, node->children[c], node->bounds[c], depth + 1);
+      else setEmpty(index, c);
+    }
+  }
+
+  void setChild(uint32_t index, int c, const BuildNode* child, const Bounds3& b, uint32_t depth) {
+    for (int a = 0; a < 3; ++a) {
+      nodes_[index].bounds[6 * c + a] = b.lower[a];
+      nodes_[index].bounds[6 * c + 3 + a] = b.upper[a];
+    }
+    double relArea = surfaceArea(b) / rootArea_;
+    if (child->leaf) {
+      const auto* leaf = static_cast<const BuildLeaf*>(child);
+      nodes_[index].child[c] = ~int32_t(tris_.size());
+      nodes_[index].count[c] = leaf->count;
+      for (uint32_t i = 0; i < leaf->count; ++i) tris_.push_back(triangle(leaf->prims[i]));
+      stats_.leaves++;
+      stats_.sahCost += relArea * leaf->count;
+      stats_.maxDepth = std::max(stats_.maxDepth, depth);
+    } else {
+      uint32_t childIndex = uint32_t(nodes_.size());
+      nodes_.push_back({});
+      nodes_[index].child[c] = int32_t(childIndex);
+      nodes_[index].count[c] = 0;
+      stats_.sahCost += relArea;
+      fillInner(childIndex, static_cast<const BuildInner*>(child), depth);
+    }
+  }
+
+  void setEmpty(uint32_t index, int c) {
+    for (int a = 0; a < 3; ++a) {
+      nodes_[index].bounds[6 * c + a] = INFINITY;
+      nodes_[index].bounds[6 * c + 3 + a] = -INFINITY;
+    }
+    nodes_[index].child[c] = ~0;
+    nodes_[index].count[c] = 0;
+  }
+
+  BvhTriangle triangle(uint32_t prim) const {
+    BvhTriangle t{};
+    t.v0 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim)]];
+    t.v1 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 1]];
+    t.v2 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 2]];
+    t.primId = prim;
+    return t;
+  }
+
+  const BuildInput& in_;
+  std::vector<BvhNode>& nodes_;
+  std::vector<BvhTriangle>& tris_;
+  BvhBuildStats& stats_;
+  double rootArea_ = 1.0;
+};
+
+}  // namespace
+
+Bvh Bvh::build(const Scene& scene) {
+  SceneView v = scene.view();
+  return build(scene.vertices(), std::vector<uint32_t>(v.indices, v.indices + 3 * size_t(v.triangleCount)));
+}
+
+Bvh Bvh::build(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices) {
+  auto start = std::chrono::steady_clock::now();
+  size_t triangleCount = indices.size() / 3;
+  if (triangleCount >= (size_t(1) << 30)) throw Error("too many triangles for the GPU BVH: " + std::to_string(triangleCount));
+  BuildInput input{&vertices, &indices};
+
+  // Spatial splits need room for the references they add.
+  std::vector<RTCBuildPrimitive> prims(std::max<size_t>(2 * triangleCount, 1));
+  Bounds3 rootBounds;
+  size_t count = 0;
+  for (size_t i = 0; i < triangleCount; ++i) {
+    Bounds3 b;
+    for (int k = 0; k < 3; ++k) b.extend(vertices[indices[3 * i + k]]);
+    if (!isFinite(b.lower) || !isFinite(b.upper)) continue;  // the scene drops these; raw input may not
+    RTCBuildPrimitive& p = prims[count++];
+    p.lower_x = b.lower.x, p.lower_y = b.lower.y, p.lower_z = b.lower.z;
+    p.upper_x = b.upper.x, p.upper_y = b.upper.y, p.upper_z = b.upper.z;
+    p.geomID = 0;
+    p.primID = unsigned(i);
+    rootBounds.extend(b.lower);
+    rootBounds.extend(b.upper);
+  }
+
+  Bvh bvh;
+  bvh.stats_.inputTriangles = uint32_t(triangleCount);
+  if (count == 0) {
+    Flattener(input, bvh.nodes_, bvh.triangles_, bvh.stats_).flattenRoot(nullptr, rootBounds);
+  } else {
+    RTCDevice device = rtcNewDevice(nullptr);
+    if (!device) throw Error("Embree: cannot create a device for the BVH build");
+    RTCBVH handle = rtcNewBVH(device);
+    RTCBuildArguments args = rtcDefaultBuildArguments();
+    args.byteSize = sizeof(args);
+    args.buildQuality = RTC_BUILD_QUALITY_HIGH;  // SAH with spatial splits
+    args.buildFlags = RTC_BUILD_FLAG_NONE;
+    args.maxBranchingFactor = 2;
+    args.maxDepth = kMaxDepth;
+    args.sahBlockSize = 1;
+    args.minLeafSize = 1;
+    args.maxLeafSize = kMaxLeafSize;
+    args.traversalCost = 1.0f;
+    args.intersectionCost = 1.0f;
+    args.bvh = handle;
+    args.primitives = prims.data();
+    args.primitiveCount = count;
+    args.primitiveArrayCapacity = prims.size();
+    args.createNode = createInner;
+    args.setNodeChildren = setChildren;
+    args.setNodeBounds = setBounds;
+    args.createLeaf = createLeaf;
+    args.splitPrimitive = splitPrimitive;
+    args.userPtr = &input;
+    auto* root = static_cast<BuildNode*>(rtcBuildBVH(&args));
+    RTCError error = rtcGetDeviceError(device);
+    if (!root || error != RTC_ERROR_NONE) {
+      rtcReleaseBVH(handle);
+      rtcReleaseDevice(device);
+      throw Error("Embree: the BVH build failed (error " + std::to_string(int(error)) + ")");
+    }
+    Flattener(input, bvh.nodes_, bvh.triangles_, bvh.stats_).flattenRoot(root, rootBounds);
+    rtcReleaseBVH(handle);
+    rtcReleaseDevice(device);
+  }
+  bvh.stats_.nodes = uint32_t(bvh.nodes_.size());
+  bvh.stats_.triangleReferences = uint32_t(bvh.triangles_.size());
+  bvh.stats_.buildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return bvh;
+}
+
+}  // namespace pvr

@@ -1,0 +1,168 @@
+#include "pvr/cuda/cuda_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "pvr/cuda/gpu_gather.cuh"
+#include "pvr/cuda/gpu_scene.cuh"
+
+namespace pvr {
+
+bool cudaDeviceUsable(std::string* why) {
+  int count = 0;
+  cudaError_t status = cudaGetDeviceCount(&count);
+  if (status != cudaSuccess || count == 0) {
+    if (why)
+      *why = status == cudaSuccess ? std::string("no CUDA GPU is present")
+                                   : std::string("no usable CUDA GPU (") + cudaGetErrorString(status) + ")";
+    cudaGetLastError();
+    return false;
+  }
+  return true;
+}
+
+struct CudaFrameRenderer::Impl {
+  const Scene& scene;
+  Bvh bvh;
+  cudaStream_t stream = nullptr;
+  cuda::DeviceScene deviceScene;
+  cuda::GpuPhotonTracer tracer;
+  cuda::GpuHashGrid grid;
+  cuda::GpuKdTree tree;
+  cuda::GpuGather gather;
+  cuda::EventTimer traceTimer, buildTimer;
+  cuda::EyeTimers eyeTimers[2];
+  cudaDeviceProp properties{};
+
+  explicit Impl(const Scene& s) : scene(s), bvh(Bvh::build(s)) {
+    PVR_CUDA_CHECK(cudaGetDeviceProperties(&properties, 0));
+    PVR_CUDA_CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
+    deviceScene.upload(scene, bvh);
+  }
+  ~Impl() { cudaStreamDestroy(stream); }
+};
+
+CudaFrameRenderer::CudaFrameRenderer(const Scene& scene) {
+  std::string why;
+  if (!cudaDeviceUsable(&why)) throw Error("--backend cuda: " + why);
+  impl_ = std::make_unique<Impl>(scene);
+}
+
+CudaFrameRenderer::~CudaFrameRenderer() = default;
+
+std::string CudaFrameRenderer::deviceName() const {
+  const cudaDeviceProp& p = impl_->properties;
+  return std::string(p.name) + " (sm_" + std::to_string(p.major) + std::to_string(p.minor) + ", " +
+         std::to_string(p.multiProcessorCount) + " SMs, " + std::to_string(p.totalGlobalMem >> 30) + " GiB)";
+}
+
+const BvhBuildStats& CudaFrameRenderer::bvhStats() const { return impl_->bvh.stats(); }
+
+size_t CudaFrameRenderer::deviceBytes() const { return cuda::deviceBytesInUse(); }
+
+FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
+  validateOptions(options, rig);
+  Impl& m = *impl_;
+  FrameResult frame;
+  PhotonTraceParams traceParams;
+  traceParams.photonCount = options.photonCount();
+  traceParams.seed = options.gather.seed;
+  traceParams.maxDepth = options.maxPhotonDepth;
+  traceParams.storeDirect = options.gather.mode == ShadingMode::PhotonMapOnly;
+
+  m.traceTimer.start(m.stream);
+  uint32_t stored = m.tracer.trace(m.deviceScene, traceParams, m.stream);
+  m.traceTimer.stop(m.stream);
+  frame.storedPhotons = stored;
+
+  cuda::DeviceMap map;
+  HashGridView gridView;
+  KdTreeView treeView;
+  double kdHostMs = 0;
+  if (options.map == PhotonMapKind::HashGrid) {
+    m.buildTimer.start(m.stream);
+    m.grid.build(m.tracer.photons(), stored, m.tracer.bounds(), options.gather.density.radius, m.stream);
+    m.buildTimer.stop(m.stream);
+    gridView = m.grid.view();
+    map.grid = &gridView;
+    frame.mapBytes = m.grid.memoryBytes();
+  } else {
+    auto t0 = std::chrono::steady_clock::now();
+    m.tree.build(m.tracer.photons(), stored, m.stream);
+    kdHostMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    treeView = m.tree.view();
+    map.tree = &treeView;
+    frame.mapBytes = m.tree.memoryBytes();
+  }
+
+  for (int e = 0; e < 2; ++e) {
+    if (!options.eyes[e]) continue;
+    m.gather.renderEye(m.deviceScene, map, options, rig.eye(Eye(e)), Eye(e), m.stream, m.eyeTimers[e]);
+  }
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  frame.timings.photonTraceMs = m.traceTimer.ms();
+  frame.timings.mapBuildMs = options.map == PhotonMapKind::HashGrid ? m.buildTimer.ms() : kdHostMs;
+  for (int e = 0; e < 2; ++e) {
+    if (!options.eyes[e]) continue;
+    frame.timings.eyeRayMs[e] = m.eyeTimers[e].raysMs();
+    frame.timings.densityMs[e] = m.eyeTimers[e].densityMs();
+    frame.timings.eyeMs[e] = frame.timings.eyeRayMs[e] + frame.timings.densityMs[e];
+  }
+  frame.deviceBytes = cuda::deviceBytesInUse();
+
+  if (images) {
+    for (int e = 0; e < 2; ++e) {
+      if (!options.eyes[e]) continue;
+      EyeResult& out = frame.eyes[e];
+      out.image = Image(rig.width, rig.height);
+      out.firstPrim.resize(size_t(rig.width) * rig.height);
+      PVR_CUDA_CHECK(cudaMemcpyAsync(out.image.pixels.data(), m.gather.image(Eye(e)), out.image.pixels.size() * sizeof(Vec3),
+                                     cudaMemcpyDeviceToHost, m.stream));
+      PVR_CUDA_CHECK(cudaMemcpyAsync(out.firstPrim.data(), m.gather.firstPrim(Eye(e)), out.firstPrim.size() * sizeof(uint32_t),
+                                     cudaMemcpyDeviceToHost, m.stream));
+    }
+    PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  }
+  return frame;
+}
+
+std::vector<Photon> CudaFrameRenderer::tracePhotons(const PhotonTraceParams& params) {
+  Impl& m = *impl_;
+  uint32_t n = m.tracer.trace(m.deviceScene, params, m.stream);
+  std::vector<Photon> photons(n);
+  if (n)
+    PVR_CUDA_CHECK(cudaMemcpyAsync(photons.data(), m.tracer.photons(), n * sizeof(Photon), cudaMemcpyDeviceToHost, m.stream));
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  return photons;
+}
+
+double CudaFrameRenderer::buildHashGrid(const std::vector<Photon>& photons, float radius, int repeats,
+                                        GpuHashGridCopy* copy) {
+  Impl& m = *impl_;
+  cuda::DeviceBuffer<Photon> input;
+  input.upload(photons.data(), photons.size(), "benchmark photons", m.stream);
+  Bounds3 bounds;  // what the tracer's kernel reduces on the device
+  for (const Photon& p : photons) bounds.extend(p.position);
+  std::vector<double> times;
+  for (int r = -1; r < std::max(repeats, 1); ++r) {
+    m.buildTimer.start(m.stream);
+    m.grid.build(input.data(), uint32_t(photons.size()), bounds, radius, m.stream);
+    m.buildTimer.stop(m.stream);
+    double ms = m.buildTimer.ms();
+    if (r >= 0) times.push_back(ms);
+  }
+  if (copy) m.grid.download(copy->photons, copy->cellStart, copy->sortedToInput);
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+
+GpuRayThroughput CudaFrameRenderer::measureRays(const StereoRig& rig, int repeats) {
+  cuda::RayThroughput t = cuda::measureRayThroughput(impl_->deviceScene, rig, repeats, impl_->stream);
+  GpuRayThroughput out;
+  out.primaryRays = t.primaryRays, out.shadowRays = t.shadowRays, out.diffuseRays = t.diffuseRays;
+  out.primaryMs = t.primaryMs, out.shadowMs = t.shadowMs, out.diffuseMs = t.diffuseMs;
+  out.leftPrimaryHits = std::move(t.primaryHits);
+  return out;
+}
+
+}  // namespace pvr

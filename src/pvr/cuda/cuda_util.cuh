@@ -1,0 +1,108 @@
+#pragma once
+// CUDA plumbing for the backend: error checks that throw pvr::Error (one clear line for the
+// user, GPU out-of-memory included), device buffers that count the memory they hold, and event
+// timing of stages.
+#include <cuda_runtime.h>
+
+#include <atomic>
+#include <cstddef>
+#include <string>
+#include <utility>
+
+#include "pvr/util/error.h"
+
+namespace pvr::cuda {
+
+[[noreturn]] void throwCudaError(cudaError_t error, const char* what, const char* file, int line);
+
+#define PVR_CUDA_CHECK(call)                                                   \
+  do {                                                                         \
+    cudaError_t pvrCudaStatus_ = (call);                                       \
+    if (pvrCudaStatus_ != cudaSuccess) ::pvr::cuda::throwCudaError(pvrCudaStatus_, #call, __FILE__, __LINE__); \
+  } while (0)
+
+// After a kernel launch: launch errors (bad configuration) surface here, faults at the next sync.
+#define PVR_CUDA_CHECK_LAUNCH(name) PVR_CUDA_CHECK(cudaPeekAtLastError())
+
+// Bytes held by every DeviceBuffer, and the optional limit (PVR_GPU_MEMORY_LIMIT_MB) that makes
+// allocations past it fail as if the GPU were out of memory.
+size_t deviceBytesInUse();
+void* deviceAllocate(size_t bytes, const char* what);
+void deviceFree(void* p, size_t bytes);
+
+template <class T>
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  DeviceBuffer(DeviceBuffer&& o) noexcept { swap(o); }
+  DeviceBuffer& operator=(DeviceBuffer&& o) noexcept {
+    swap(o);
+    return *this;
+  }
+  ~DeviceBuffer() { release(); }
+
+  // Room for n elements; contents are discarded when the buffer grows.
+  void reserve(size_t n, const char* what) {
+    if (n <= capacity_) return;
+    release();
+    data_ = static_cast<T*>(deviceAllocate(n * sizeof(T), what));
+    capacity_ = n;
+  }
+  void upload(const T* host, size_t n, const char* what, cudaStream_t stream = nullptr) {
+    reserve(n, what);
+    if (n) PVR_CUDA_CHECK(cudaMemcpyAsync(data_, host, n * sizeof(T), cudaMemcpyHostToDevice, stream));
+  }
+  void download(T* host, size_t n, cudaStream_t stream = nullptr) const {
+    if (n) PVR_CUDA_CHECK(cudaMemcpyAsync(host, data_, n * sizeof(T), cudaMemcpyDeviceToHost, stream));
+    PVR_CUDA_CHECK(cudaStreamSynchronize(stream));
+  }
+  void release() {
+    if (data_) deviceFree(data_, capacity_ * sizeof(T));
+    data_ = nullptr;
+    capacity_ = 0;
+  }
+  T* data() const { return data_; }
+  size_t capacity() const { return capacity_; }
+  size_t bytes() const { return capacity_ * sizeof(T); }
+
+ private:
+  void swap(DeviceBuffer& o) noexcept {
+    std::swap(data_, o.data_);
+    std::swap(capacity_, o.capacity_);
+  }
+  T* data_ = nullptr;
+  size_t capacity_ = 0;
+};
+
+// Times a region of a stream with a pair of events.
+class EventTimer {
+ public:
+  EventTimer() {
+    PVR_CUDA_CHECK(cudaEventCreate(&start_));
+    PVR_CUDA_CHECK(cudaEventCreate(&stop_));
+  }
+  ~EventTimer() {
+    cudaEventDestroy(start_);
+    cudaEventDestroy(stop_);
+  }
+  EventTimer(const EventTimer&) = delete;
+  EventTimer& operator=(const EventTimer&) = delete;
+  void start(cudaStream_t s) { PVR_CUDA_CHECK(cudaEventRecord(start_, s)); }
+  void stop(cudaStream_t s) { PVR_CUDA_CHECK(cudaEventRecord(stop_, s)); }
+  // Waits for the stop event.
+  double ms() const {
+    PVR_CUDA_CHECK(cudaEventSynchronize(stop_));
+    float v = 0;
+    PVR_CUDA_CHECK(cudaEventElapsedTime(&v, start_, stop_));
+    return double(v);
+  }
+
+ private:
+  cudaEvent_t start_ = nullptr, stop_ = nullptr;
+};
+
+inline unsigned blocksFor(size_t n, unsigned threads) { return unsigned((n + threads - 1) / threads); }
+
+}  // namespace pvr::cuda

@@ -1,0 +1,362 @@
+#include <cub/device/device_radix_sort.cuh>
+
+#include <algorithm>
+#include <vector>
+
+#include "pvr/cuda/gpu_gather.cuh"
+
+namespace pvr::cuda {
+namespace {
+
+constexpr int kTile = 8;  // 8x8-pixel blocks: each warp an 8x4 tile of coherent rays and hit points
+
+__device__ inline bool tilePixel(int width, int height, int& x, int& y) {
+  x = int(blockIdx.x) * kTile + int(threadIdx.x);
+  y = int(blockIdx.y) * kTile + int(threadIdx.y);
+  return x < width && y < height;
+}
+
+dim3 tileGrid(int width, int height) { return dim3(unsigned((width + kTile - 1) / kTile), unsigned((height + kTile - 1) / kTile)); }
+
+// Stores the sample's contribution: the running sum, scaled on the last sample (the CPU's order).
+__device__ inline void storeSample(Vec3* image, size_t pixel, Vec3 c, int sample, int samples) {
+  Vec3 v = sample == 0 ? c : image[pixel] + c;
+  if (sample == samples - 1 && samples > 1) v *= 1.0f / float(samples);
+  image[pixel] = v;
+}
+
+// The paper's "single" scheme: eye ray and estimate in one kernel.
+template <class Map, Estimator E>
+__global__ void singleKernel(SceneView scene, BvhIntersector intersector, Map map, GatherParams params,
+                             EyeCamera camera, Eye eye, Vec3* image, uint32_t* firstPrim) {
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  params.density.estimator = E;  // compile-time estimator: the radius kernel carries no heap
+  PixelSample s = shadePixel(scene, intersector, map, params, camera, eye, x, y);
+  size_t pixel = size_t(y) * camera.width + x;
+  image[pixel] = s.radiance;
+  firstPrim[pixel] = s.firstPrim;
+}
+
+// Hybrid, first kernel: eye rays to their gather points.
+__global__ void eyeRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
+                              Eye eye, int sample, GatherPoint* points, uint32_t* firstPrim) {
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  CounterRng rng(0, 0, 0);
+  Ray ray = pixelSampleRay(params, camera, eye, x, y, sample, rng);
+  uint32_t prim = ~0u;
+  size_t pixel = size_t(y) * camera.width + x;
+  points[pixel] = traceToDiffuse(scene, intersector, params, ray, rng, sample == 0 ? &prim : nullptr);
+  if (sample == 0) firstPrim[pixel] = prim;
+}
+
+// Hybrid, second kernel: one estimate per gather point, in the same 8x8 tiles.
+template <class Map, Estimator E>
+__global__ void densityKernel(Map map, DensityParams density, const GatherPoint* points, int width, int height,
+                              int sample, int samples, Vec3* image) {
+  int x, y;
+  if (!tilePixel(width, height, x, y)) return;
+  density.estimator = E;
+  size_t pixel = size_t(y) * width + x;
+  storeSample(image, pixel, finishGather(map, points[pixel], density), sample, samples);
+}
+
+// The paper's Algorithm 1. The threads of an 8x8 block find their gather points' cells; if all
+// that need an estimate agree on one cell, the block walks that cell's 9 neighbouring rows
+// together, each thread staging one photon of every 64 into shared memory, and each thread
+// tests all staged photons against its own point. Otherwise each thread estimates alone.
+template <Estimator E>
+__global__ void __launch_bounds__(kTile* kTile) sharedDensityKernel(HashGridView map, DensityParams density,
+                                                                    const GatherPoint* points, int width, int height,
+                                                                    int sample, int samples, Vec3* image) {
+  constexpr int kThreads = kTile * kTile;
+  __shared__ Photon staged[kThreads];
+  __shared__ int cellMin, cellMax;
+  int tid = int(threadIdx.y) * kTile + int(threadIdx.x);
+  int x, y;
+  bool inside = tilePixel(width, height, x, y);
+  size_t pixel = size_t(y) * width + x;
+  GatherPoint gp;
+  if (inside) gp = points[pixel];
+  int64_t cell = inside && gp.needsEstimate() ? map.cellOf(gp.position) : -1;
+  bool estimating = cell >= 0;  // a point outside the grid has no photons in reach
+  if (tid == 0) cellMin = INT_MAX, cellMax = -1;
+  __syncthreads();
+  if (estimating) {
+    atomicMin(&cellMin, int(cell));
+    atomicMax(&cellMax, int(cell));
+  }
+  __syncthreads();
+  density.estimator = E;
+  Vec3 result = gp.radiance;
+  if (cellMin != cellMax) {  // the block disagrees (block-uniform branch)
+    if (estimating) result = finishGather(map, gp, density);
+  } else if (cellMax >= 0) {
+    float r2 = density.radius * density.radius;
+    Vec3 sum{0, 0, 0};
+    KnnHeap heap(E == Estimator::Knn ? density.k : 1);
+    float searchR2 = r2;
+    for (int row = 0; row < 9; ++row) {
+      uint32_t first = uint32_t(cellMax + map.rowOffsets[row]);
+      uint32_t begin = map.cellStart[first], end = map.cellStart[first + 3];
+      for (uint32_t base = begin; base < end; base += kThreads) {
+        if (base + tid < end) staged[tid] = map.photons[base + tid];
+        __syncthreads();
+        uint32_t n = end - base < uint32_t(kThreads) ? end - base : uint32_t(kThreads);
+        if (estimating) {
+          for (uint32_t k = 0; k < n; ++k) {
+            float d2 = photonDistance2(gp.position, staged[k].position);
+            if (d2 <= searchR2 && photonFacesSurface(staged[k].direction, gp.normal)) {
+              if (E == Estimator::Radius) sum += staged[k].power;
+              else heap.offer(d2, base + k, searchR2);
+            }
+          }
+        }
+        __syncthreads();
+      }
+    }
+    if (estimating) {
+      Vec3 flux = E == Estimator::Radius ? sum * (1.0f / (kPi * r2)) : knnFluxDensity(map, heap, r2);
+      result = gp.radiance + gp.weight * flux;
+    }
+  }
+  if (inside) storeSample(image, pixel, result, sample, samples);
+}
+
+// Our improvement: gather points sorted by cell, so consecutive threads share their cell.
+__global__ void cellKeysOfPointsKernel(HashGridView map, const GatherPoint* points, uint32_t n, uint32_t noCell,
+                                       uint32_t* keys, uint32_t* values) {
+  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  GatherPoint gp = points[i];
+  int64_t cell = gp.needsEstimate() ? map.cellOf(gp.position) : -1;
+  keys[i] = cell < 0 ? noCell : uint32_t(cell);
+  values[i] = i;
+}
+
+template <Estimator E>
+__global__ void sortedDensityKernel(HashGridView map, DensityParams density, const GatherPoint* points,
+                                    const uint32_t* order, uint32_t n, int sample, int samples, Vec3* image) {
+  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  density.estimator = E;
+  uint32_t pixel = order[i];
+  storeSample(image, pixel, finishGather(map, points[pixel], density), sample, samples);
+}
+
+// Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
+__global__ void primaryRaysKernel(BvhIntersector intersector, EyeCamera camera, Hit* hits) {
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  Hit hit;
+  intersector.intersect(camera.generateRay(float(x) + 0.5f, float(y) + 0.5f), INFINITY, hit);
+  hits[size_t(y) * camera.width + x] = hit;
+}
+
+__device__ inline bool primaryPoint(const SceneView& scene, const EyeCamera& camera, const Hit* hits, int x, int y,
+                                    SurfacePoint& sp) {
+  Hit hit = hits[size_t(y) * camera.width + x];
+  if (!hit.valid()) return false;
+  sp = scene.surfacePoint(hit);
+  Ray ray = camera.generateRay(float(x) + 0.5f, float(y) + 0.5f);
+  if (dot(ray.dir, sp.geometricNormal) > 0.0f) sp.geometricNormal = -sp.geometricNormal;
+  return true;
+}
+
+__global__ void shadowRaysKernel(SceneView scene, BvhIntersector intersector, EyeCamera camera, const Hit* hits,
+                                 uint8_t* occluded) {
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  SurfacePoint sp;
+  size_t pixel = size_t(y) * camera.width + x;
+  if (!primaryPoint(scene, camera, hits, x, y, sp)) return;
+  CounterRng rng(7, uint32_t(pixel), 0);
+  float uPick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+  LightSample ls = sampleLight(scene, uPick, u1, u2);
+  Vec3 origin = sp.position + sp.geometricNormal * scene.rayEpsilon();
+  Vec3 d = ls.position - origin;
+  float dist = length(d);
+  occluded[pixel] = intersector.occluded({origin, d / dist}, dist * (1.0f - 1e-3f)) ? 1 : 0;
+}
+
+__global__ void diffuseRaysKernel(SceneView scene, BvhIntersector intersector, EyeCamera camera, const Hit* hits,
+                                  Hit* out) {
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  SurfacePoint sp;
+  size_t pixel = size_t(y) * camera.width + x;
+  Hit hit;
+  if (primaryPoint(scene, camera, hits, x, y, sp)) {
+    CounterRng rng(11, uint32_t(pixel), 0);
+    Vec3 local = sampleCosineHemisphere(rng.uniform(), rng.uniform());
+    Ray ray{sp.position + sp.geometricNormal * scene.rayEpsilon(), Frame::fromNormal(sp.geometricNormal).toWorld(local)};
+    intersector.intersect(ray, INFINITY, hit);
+  }
+  out[pixel] = hit;
+}
+
+int bitsFor(uint64_t values) {
+  int bits = 1;
+  while (bits < 32 && (uint64_t(1) << bits) < values) ++bits;
+  return bits;
+}
+
+template <Estimator E, class Map>
+void launchSingle(const DeviceScene& scene, const Map& map, const GatherParams& params, const EyeCamera& camera,
+                  Eye eye, Vec3* image, uint32_t* firstPrim, cudaStream_t stream) {
+  singleKernel<Map, E><<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
+      scene.view, scene.intersector, map, params, camera, eye, image, firstPrim);
+  PVR_CUDA_CHECK_LAUNCH("single");
+}
+
+template <Estimator E, class Map>
+void launchDensity(const Map& map, const DensityParams& density, const GatherPoint* points, const EyeCamera& camera,
+                   int sample, int samples, Vec3* image, cudaStream_t stream) {
+  densityKernel<Map, E><<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
+      map, density, points, camera.width, camera.height, sample, samples, image);
+  PVR_CUDA_CHECK_LAUNCH("density");
+}
+
+template <Estimator E>
+void dispatchSingle(const DeviceScene& scene, DeviceMap map, const GatherParams& params, const EyeCamera& camera,
+                    Eye eye, Vec3* image, uint32_t* firstPrim, cudaStream_t stream) {
+  if (map.grid) launchSingle<E>(scene, *map.grid, params, camera, eye, image, firstPrim, stream);
+  else launchSingle<E>(scene, *map.tree, params, camera, eye, image, firstPrim, stream);
+}
+
+}  // namespace
+
+size_t GpuGather::memoryBytes() const {
+  size_t bytes = points_.bytes() + temp_.bytes();
+  for (int i = 0; i < 2; ++i)
+    bytes += images_[i].bytes() + firstPrim_[i].bytes() + sortKeys_[i].bytes() + sortValues_[i].bytes();
+  return bytes;
+}
+
+void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options,
+                          const EyeCamera& camera, Eye eye, cudaStream_t stream, EyeTimers& timers) {
+  const size_t pixels = size_t(camera.width) * camera.height;
+  const GatherParams& params = options.gather;
+  const bool knn = params.density.estimator == Estimator::Knn;
+  Vec3* image = (images_[int(eye)].reserve(pixels, "eye image"), images_[int(eye)].data());
+  uint32_t* firstPrim = (firstPrim_[int(eye)].reserve(pixels, "first-hit ids"), firstPrim_[int(eye)].data());
+
+  if (options.kernel == DensityKernel::Single) {  // shadePixel loops over the samples itself
+    timers.prepare(1);
+    timers.rays[0]->start(stream);
+    if (knn) dispatchSingle<Estimator::Knn>(scene, map, params, camera, eye, image, firstPrim, stream);
+    else dispatchSingle<Estimator::Radius>(scene, map, params, camera, eye, image, firstPrim, stream);
+    timers.rays[0]->stop(stream);
+    timers.density[0]->start(stream);
+    timers.density[0]->stop(stream);
+    return;
+  }
+
+  points_.reserve(pixels, "gather points");
+  const bool sorted = options.kernel == DensityKernel::CellSorted;
+  uint32_t noCell = 0;
+  int endBit = 1;
+  if (sorted) {
+    for (int b = 0; b < 2; ++b) {
+      sortKeys_[b].reserve(pixels, "gather-point cell keys");
+      sortValues_[b].reserve(pixels, "gather-point order");
+    }
+    noCell = uint32_t(uint64_t(map.grid->dims[0]) * map.grid->dims[1] * map.grid->dims[2]);
+    endBit = bitsFor(uint64_t(noCell) + 1);
+    size_t bytes = 0;
+    cub::DoubleBuffer<uint32_t> k(sortKeys_[0].data(), sortKeys_[1].data()), v(sortValues_[0].data(), sortValues_[1].data());
+    PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, k, v, int(pixels), 0, endBit, stream));
+    temp_.reserve(bytes, "gather-point sort scratch");
+  }
+  timers.prepare(params.samplesPerPixel);
+  for (int s = 0; s < params.samplesPerPixel; ++s) {
+    timers.rays[s]->start(stream);
+    eyeRaysKernel<<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
+        scene.view, scene.intersector, params, camera, eye, s, points_.data(), firstPrim);
+    PVR_CUDA_CHECK_LAUNCH("eyeRays");
+    timers.rays[s]->stop(stream);
+    timers.density[s]->start(stream);
+    if (options.kernel == DensityKernel::Hybrid) {
+      if (map.grid) {
+        if (knn) launchDensity<Estimator::Knn>(*map.grid, params.density, points_.data(), camera, s, params.samplesPerPixel, image, stream);
+        else launchDensity<Estimator::Radius>(*map.grid, params.density, points_.data(), camera, s, params.samplesPerPixel, image, stream);
+      } else {
+        if (knn) launchDensity<Estimator::Knn>(*map.tree, params.density, points_.data(), camera, s, params.samplesPerPixel, image, stream);
+        else launchDensity<Estimator::Radius>(*map.tree, params.density, points_.data(), camera, s, params.samplesPerPixel, image, stream);
+      }
+    } else if (options.kernel == DensityKernel::SharedMemory) {
+      auto* kernel = knn ? sharedDensityKernel<Estimator::Knn> : sharedDensityKernel<Estimator::Radius>;
+      kernel<<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
+          *map.grid, params.density, points_.data(), camera.width, camera.height, s, params.samplesPerPixel, image);
+      PVR_CUDA_CHECK_LAUNCH("sharedDensity");
+    } else {
+      cellKeysOfPointsKernel<<<blocksFor(pixels, 256), 256, 0, stream>>>(*map.grid, points_.data(), uint32_t(pixels),
+                                                                          noCell, sortKeys_[0].data(), sortValues_[0].data());
+      PVR_CUDA_CHECK_LAUNCH("cellKeysOfPoints");
+      cub::DoubleBuffer<uint32_t> k(sortKeys_[0].data(), sortKeys_[1].data()), v(sortValues_[0].data(), sortValues_[1].data());
+      size_t bytes = temp_.capacity();
+      PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, k, v, int(pixels), 0, endBit, stream));
+      auto* kernel = knn ? sortedDensityKernel<Estimator::Knn> : sortedDensityKernel<Estimator::Radius>;
+      kernel<<<blocksFor(pixels, 128), 128, 0, stream>>>(*map.grid, params.density, points_.data(), v.Current(),
+                                                         uint32_t(pixels), s, params.samplesPerPixel, image);
+      PVR_CUDA_CHECK_LAUNCH("sortedDensity");
+    }
+    timers.density[s]->stop(stream);
+  }
+}
+
+static double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+RayThroughput measureRayThroughput(const DeviceScene& scene, const StereoRig& rig, int repeats, cudaStream_t stream) {
+  RayThroughput out;
+  const size_t pixels = size_t(rig.width) * rig.height;
+  DeviceBuffer<Hit> primary[2], secondary;
+  DeviceBuffer<uint8_t> occluded;
+  for (auto& p : primary) p.reserve(pixels, "primary hits");
+  secondary.reserve(pixels, "diffuse hits");
+  occluded.reserve(pixels, "shadow results");
+  std::vector<double> timesPrimary, timesShadow, timesDiffuse;
+  EventTimer timer;
+  dim3 grid = tileGrid(rig.width, rig.height), block(kTile, kTile);
+  for (int r = -1; r < repeats; ++r) {  // r = -1 warms up
+    double primaryMs = 0, shadowMs = 0, diffuseMs = 0;
+    for (int e = 0; e < 2; ++e) {
+      EyeCamera camera = rig.eye(Eye(e));
+      timer.start(stream);
+      primaryRaysKernel<<<grid, block, 0, stream>>>(scene.intersector, camera, primary[e].data());
+      PVR_CUDA_CHECK_LAUNCH("primaryRays");
+      timer.stop(stream);
+      primaryMs += timer.ms();
+      timer.start(stream);
+      shadowRaysKernel<<<grid, block, 0, stream>>>(scene.view, scene.intersector, camera, primary[e].data(), occluded.data());
+      PVR_CUDA_CHECK_LAUNCH("shadowRays");
+      timer.stop(stream);
+      shadowMs += timer.ms();
+      timer.start(stream);
+      diffuseRaysKernel<<<grid, block, 0, stream>>>(scene.view, scene.intersector, camera, primary[e].data(), secondary.data());
+      PVR_CUDA_CHECK_LAUNCH("diffuseRays");
+      timer.stop(stream);
+      diffuseMs += timer.ms();
+    }
+    if (r < 0) continue;
+    timesPrimary.push_back(primaryMs);
+    timesShadow.push_back(shadowMs);
+    timesDiffuse.push_back(diffuseMs);
+  }
+  out.primaryMs = median(timesPrimary), out.shadowMs = median(timesShadow), out.diffuseMs = median(timesDiffuse);
+  std::vector<Hit> hits(pixels);
+  out.primaryRays = 2 * pixels;
+  for (int e = 1; e >= 0; --e) {
+    primary[e].download(hits.data(), pixels, stream);
+    for (const Hit& h : hits) out.shadowRays += h.valid() ? 1 : 0;
+  }
+  out.diffuseRays = out.shadowRays;
+  out.primaryHits = std::move(hits);  // the left eye's, downloaded last
+  return out;
+}
+
+}  // namespace pvr::cuda

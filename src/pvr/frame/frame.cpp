@@ -1,0 +1,45 @@
+#include "pvr/frame/frame.h"
+
+#include <cmath>
+#include <string>
+
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+constexpr int kMaxEyeDimension = 8192;
+}  // namespace
+
+const char* densityKernelName(DensityKernel k) {
+  switch (k) {
+    case DensityKernel::Single: return "single";
+    case DensityKernel::Hybrid: return "hybrid";
+    case DensityKernel::SharedMemory: return "shared";
+    case DensityKernel::CellSorted: return "sorted";
+  }
+  return "?";
+}
+
+void validateOptions(const RenderOptions& o, const StereoRig& rig) {
+  if (o.photonsX == 0 || o.photonsY == 0) throw Error("the number of photons must be positive");
+  if (uint64_t(o.photonsX) * o.photonsY > (uint64_t(1) << 26))
+    throw Error("too many photons: " + std::to_string(uint64_t(o.photonsX) * o.photonsY) + " (at most 8192x8192)");
+  if (o.maxPhotonDepth < 1 || o.maxPhotonDepth > 64) throw Error("the photon depth must be between 1 and 64");
+  const DensityParams& d = o.gather.density;
+  if (!(d.radius > 0.0f) || !std::isfinite(d.radius)) throw Error("the search radius must be a positive finite number");
+  if (d.estimator == Estimator::Knn && (d.k < 1 || d.k > kMaxKnn))
+    throw Error("k must be between 1 and " + std::to_string(kMaxKnn));
+  if (o.gather.samplesPerPixel < 1 || o.gather.samplesPerPixel > 4096)
+    throw Error("samples per pixel must be between 1 and 4096");
+  if (o.gather.maxSpecularDepth < 0 || o.gather.maxSpecularDepth > 64)
+    throw Error("the specular depth must be between 0 and 64");
+  if (rig.width < 1 || rig.height < 1 || rig.width > kMaxEyeDimension || rig.height > kMaxEyeDimension)
+    throw Error("the eye size must be between 1x1 and " + std::to_string(kMaxEyeDimension) + "x" +
+                std::to_string(kMaxEyeDimension) + ", got " + std::to_string(rig.width) + "x" + std::to_string(rig.height));
+  if (!(rig.ipd >= 0.0f) || !std::isfinite(rig.ipd)) throw Error("the IPD must be a non-negative finite number");
+  if ((o.kernel == DensityKernel::SharedMemory || o.kernel == DensityKernel::CellSorted) &&
+      o.map != PhotonMapKind::HashGrid)
+    throw Error(std::string("the ") + densityKernelName(o.kernel) + " kernel works on the hash grid, not the kd-tree");
+}
+
+}  // namespace pvr

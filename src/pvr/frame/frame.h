@@ -1,0 +1,71 @@
+#pragma once
+// One stereo frame, whatever the backend: its options (photons, photon map, density estimation,
+// GPU kernel scheme), the time of each stage, and the images. The CPU backend (Embree + TBB) is
+// the reference; the CUDA backend must agree with it.
+#include <string>
+#include <vector>
+
+#include "pvr/camera/stereo_rig.h"
+#include "pvr/frame/image.h"
+#include "pvr/photon/gather.h"
+
+namespace pvr {
+
+enum class PhotonMapKind : int { HashGrid = 0, KdTree = 1 };
+
+// How the GPU splits eye rays and density estimation (the main paper's section 3.2). Every scheme
+// computes the same image; the CPU backend computes it one way.
+enum class DensityKernel : int {
+  Single = 0,        ///< one kernel traces the eye ray and estimates (the paper's "OptiX-only")
+  Hybrid = 1,        ///< the eye-ray kernel writes gather points, a second kernel estimates
+  SharedMemory = 2,  ///< hybrid, estimation by the paper's Algorithm 1 (8x8 blocks stage photons)
+  CellSorted = 3,    ///< hybrid, gather points sorted by hash cell first, so each warp estimates one cell
+};
+
+const char* densityKernelName(DensityKernel k);
+
+struct RenderOptions {
+  uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
+  int maxPhotonDepth = 8;
+  PhotonMapKind map = PhotonMapKind::HashGrid;
+  DensityKernel kernel = DensityKernel::Hybrid;
+  GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
+  bool eyes[2] = {true, true};
+  uint32_t photonCount() const { return photonsX * photonsY; }
+};
+
+struct StageTimings {
+  double photonTraceMs = 0, mapBuildMs = 0, eyeMs[2] = {0, 0};
+  // Within an eye: eye rays (to the gather points) and density estimation; for the single
+  // kernel everything is eye rays.
+  double eyeRayMs[2] = {0, 0}, densityMs[2] = {0, 0};
+  double totalMs() const { return photonTraceMs + mapBuildMs + eyeMs[0] + eyeMs[1]; }
+};
+
+struct EyeResult {
+  Image image;
+  std::vector<uint32_t> firstPrim;  ///< per pixel, the triangle its centre ray hit first (~0u: none)
+};
+
+struct FrameResult {
+  EyeResult eyes[2];  ///< empty images when the caller asked for timings only
+  StageTimings timings;
+  size_t storedPhotons = 0;
+  size_t mapBytes = 0;
+  size_t deviceBytes = 0;  ///< GPU memory held by the backend (0 on the CPU)
+};
+
+// Checks options against the rig; throws pvr::Error naming the bad value.
+void validateOptions(const RenderOptions& options, const StereoRig& rig);
+
+class FrameRenderer {
+ public:
+  virtual ~FrameRenderer() = default;
+  // Traces photons, builds the map and shades the requested eyes. With images = false the
+  // images stay where they were rendered (benchmarks).
+  virtual FrameResult render(const StereoRig& rig, const RenderOptions& options, bool images = true) = 0;
+  virtual std::string name() const = 0;  ///< "cpu" or "cuda"
+  virtual std::string deviceName() const = 0;
+};
+
+}  // namespace pvr

@@ -1,0 +1,156 @@
+// The CUDA backend against the CPU reference (label `gpu`; runs on a machine with a CUDA GPU,
+// and reports every test as skipped elsewhere). Same scene, seed and options on both backends:
+// the stored photons, the hash grid and the images must agree.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pvr/cuda/cuda_renderer.h"
+#include "pvr/render/renderer.h"
+#include "pvr/scene/scene.h"
+
+namespace pvr {
+namespace {
+
+#define PVR_REQUIRE_GPU()                                          \
+  do {                                                             \
+    std::string why;                                               \
+    if (!cudaDeviceUsable(&why)) GTEST_SKIP() << "no GPU: " << why; \
+  } while (0)
+
+TEST(GpuBackend, StoredPhotonsMatchTheCpu) {
+  PVR_REQUIRE_GPU();
+  for (const char* name : {"cornell", "cornell-caustics"})
+    for (bool storeDirect : {false, true}) {
+      Scene scene = builtinScene(name);
+      CpuBackend cpu(scene);
+      CudaFrameRenderer gpu(scene);
+      PhotonTraceParams params;
+      params.photonCount = 128 * 128;
+      params.storeDirect = storeDirect;
+      std::vector<Photon> a = cpu.tracePhotons(params), b = gpu.tracePhotons(params);
+      ASSERT_EQ(a.size(), b.size()) << name << " storeDirect " << storeDirect;
+      size_t far = 0;
+      for (size_t i = 0; i < a.size(); ++i) {
+        bool close = length(a[i].position - b[i].position) <= 1e-4f &&
+                     length(a[i].power - b[i].power) <= 1e-4f * length(a[i].power) &&
+                     length(a[i].direction - b[i].direction) <= 1e-3f;
+        far += close ? 0 : 1;
+      }
+      EXPECT_EQ(far, 0u) << name << ": photons differing beyond float tolerance, of " << a.size();
+    }
+}
+
+TEST(GpuBackend, HashGridMatchesTheCpuBuildExactly) {
+  PVR_REQUIRE_GPU();
+  Scene scene = builtinScene("cornell");
+  CudaFrameRenderer gpu(scene);
+  PhotonTraceParams params;
+  params.photonCount = 256 * 256;
+  params.storeDirect = true;
+  std::vector<Photon> photons = gpu.tracePhotons(params);
+  for (float radius : {0.02f, 0.05f, 0.2f}) {
+    GpuHashGridCopy copy;
+    gpu.buildHashGrid(photons, radius, 1, &copy);
+    HashGrid cpu = HashGrid::build(photons, radius);
+    EXPECT_EQ(copy.cellStart, cpu.cellStart()) << radius;
+    EXPECT_EQ(copy.sortedToInput, cpu.sortedToInput()) << radius;
+    ASSERT_EQ(copy.photons.size(), cpu.photons().size());
+    for (size_t i = 0; i < copy.photons.size(); ++i) ASSERT_TRUE(copy.photons[i].position == cpu.photons()[i].position);
+  }
+}
+
+struct ImageCheck {
+  double relativeMad = 0, outliers = 0, firstPrimAgree = 0;
+};
+
+ImageCheck compare(const FrameResult& a, const FrameResult& b) {
+  ImageCheck c;
+  double sum = 0, diff = 0;
+  size_t n = 0, outliers = 0, same = 0;
+  for (int e = 0; e < 2; ++e) {
+    const auto& pa = a.eyes[e].image.pixels;
+    const auto& pb = b.eyes[e].image.pixels;
+    for (size_t i = 0; i < pa.size(); ++i)
+      for (int k = 0; k < 3; ++k) sum += std::fabs(pa[i][k]), diff += std::fabs(pa[i][k] - pb[i][k]);
+    n += pa.size();
+    for (size_t i = 0; i < pa.size(); ++i) same += a.eyes[e].firstPrim[i] == b.eyes[e].firstPrim[i] ? 1 : 0;
+  }
+  double mean = sum / (3.0 * n);
+  for (int e = 0; e < 2; ++e) {
+    const auto& pa = a.eyes[e].image.pixels;
+    const auto& pb = b.eyes[e].image.pixels;
+    for (size_t i = 0; i < pa.size(); ++i)
+      if (length(pa[i] - pb[i]) > 0.1 * mean) ++outliers;
+  }
+  c.relativeMad = diff / (3.0 * n) / mean;
+  c.outliers = double(outliers) / double(n);
+  c.firstPrimAgree = double(same) / double(n);
+  return c;
+}
+
+// Every kernel scheme, both estimators, both maps, both shading modes: the GPU image equals the
+// CPU image within 1% (mean absolute difference over the mean), with few outliers.
+TEST(GpuBackend, ImagesMatchTheCpuForEveryScheme) {
+  PVR_REQUIRE_GPU();
+  for (const char* name : {"cornell", "cornell-caustics"}) {
+    Scene scene = builtinScene(name);
+    StereoRig rig = scene.rig;
+    rig.width = 160, rig.height = 176;
+    CpuFrameRenderer cpu(scene);
+    CudaFrameRenderer gpu(scene);
+    for (ShadingMode mode : {ShadingMode::Full, ShadingMode::PhotonMapOnly})
+      for (Estimator estimator : {Estimator::Radius, Estimator::Knn})
+        for (PhotonMapKind map : {PhotonMapKind::HashGrid, PhotonMapKind::KdTree}) {
+          RenderOptions o;
+          o.photonsX = o.photonsY = 128;
+          o.map = map;
+          o.gather.mode = mode;
+          o.gather.density.radius = 0.08f;
+          o.gather.density.estimator = estimator;
+          o.gather.samplesPerPixel = 2;
+          FrameResult reference = cpu.render(rig, o);
+          for (DensityKernel kernel : {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory,
+                                       DensityKernel::CellSorted}) {
+            if (map == PhotonMapKind::KdTree && (kernel == DensityKernel::SharedMemory || kernel == DensityKernel::CellSorted))
+              continue;
+            o.kernel = kernel;
+            FrameResult frame = gpu.render(rig, o);
+            ImageCheck c = compare(reference, frame);
+            std::string what = std::string(name) + " " + densityKernelName(kernel) +
+                               (estimator == Estimator::Knn ? " knn" : " radius") +
+                               (map == PhotonMapKind::KdTree ? " kd" : " grid") +
+                               (mode == ShadingMode::Full ? " full" : " photons");
+            EXPECT_EQ(frame.storedPhotons, reference.storedPhotons) << what;
+            EXPECT_LT(c.relativeMad, 0.01) << what;
+            EXPECT_LT(c.outliers, 0.005) << what;
+            EXPECT_GT(c.firstPrimAgree, 0.995) << what;
+          }
+        }
+  }
+}
+
+TEST(GpuBackend, RayTraversalAgreesWithEmbree) {
+  PVR_REQUIRE_GPU();
+  for (const char* name : {"cornell", "cornell-caustics"}) {
+    Scene scene = builtinScene(name);
+    StereoRig rig = scene.rig;
+    rig.width = 320, rig.height = 352;
+    CudaFrameRenderer gpu(scene);
+    GpuRayThroughput t = gpu.measureRays(rig, 1);
+    CpuBackend cpu(scene);
+    EyeCamera camera = rig.eye(Eye::Left);
+    size_t agree = 0;
+    for (size_t i = 0; i < t.leftPrimaryHits.size(); ++i) {
+      Hit h;
+      bool hit = cpu.intersector().intersect(camera.generateRay(i % rig.width + 0.5f, i / rig.width + 0.5f), INFINITY, h);
+      const Hit& g = t.leftPrimaryHits[i];
+      if (hit == g.valid() && (!hit || h.primId == g.primId)) ++agree;
+    }
+    EXPECT_GE(double(agree) / double(t.leftPrimaryHits.size()), 0.999) << name;
+    EXPECT_EQ(t.primaryRays, 2u * rig.width * rig.height);
+  }
+}
+
+}  // namespace
+}  // namespace pvr
