@@ -24,7 +24,8 @@ Agreement compareWithEmbree(const Scene& scene, size_t rays) {
   Agreement a;
   for (uint32_t i = 0; i < rays; ++i) {
     CounterRng rng(3, i, 0);
-    Vec3 o = b.lower + b.extent() * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    float ux = rng.uniform(), uy = rng.uniform(), uz = rng.uniform();
+    Vec3 o = b.lower + b.extent() * Vec3(ux, uy, uz);
     float z = 1.0f - 2.0f * rng.uniform(), phi = 2.0f * kPi * rng.uniform(), s = sqrtf(fmaxf(0.0f, 1.0f - z * z));
     Ray ray{o, {s * cosf(phi), s * sinf(phi), z}};
     Hit h0, h1;

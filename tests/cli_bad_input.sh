@@ -37,6 +37,12 @@ expect_error "malformed JSON" render "$data/malformed.json" "${small[@]}"
 expect_error "cannot read" render "$data/malformed.gltf" "${small[@]}"
 expect_error "no light" render "$data/no_light.obj" "${small[@]}"
 expect_error "photons must be" render cornell --photons 0 --eye-size 8x8
+expect_error "--backend must be" render cornell --backend gpu --eye-size 8x8
+expect_error "--kernel must be" render cornell --kernel fused --eye-size 8x8
+expect_error "works on the hash grid" render cornell --kernel shared --map kdtree --eye-size 8x8
+expect_error "--suite must be" bench --suite speed
+expect_error "--frames must be" bench --suite tables --frames 0
+expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1
 expect_error "photons must be" render cornell --photons 0x256 --eye-size 8x8
 expect_error "photons" render cornell --photons -5 --eye-size 8x8
 expect_error "too large" render cornell --photons 100000x100000 --eye-size 8x8

@@ -37,7 +37,10 @@ TEST(GpuBackend, StoredPhotonsMatchTheCpu) {
                      length(a[i].direction - b[i].direction) <= 1e-3f;
         far += close ? 0 : 1;
       }
-      EXPECT_EQ(far, 0u) << name << ": photons differing beyond float tolerance, of " << a.size();
+      // Diffuse-only paths agree photon for photon. Behind glass, a path whose Fresnel choice or
+      // hit triangle sits on a rounding boundary (nvcc fuses multiply-adds) may diverge: a few.
+      size_t allowed = std::string(name) == "cornell" ? 0 : a.size() / 2000;
+      EXPECT_LE(far, allowed) << name << ": photons differing beyond float tolerance, of " << a.size();
     }
 }
 

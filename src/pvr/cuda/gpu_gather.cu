@@ -189,7 +189,10 @@ __global__ void diffuseRaysKernel(SceneView scene, BvhIntersector intersector, E
   Hit hit;
   if (primaryPoint(scene, camera, hits, x, y, sp)) {
     CounterRng rng(11, uint32_t(pixel), 0);
-    Vec3 local = sampleCosineHemisphere(rng.uniform(), rng.uniform());
+    // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+    float uTheta = rng.uniform();
+    float uPhi = rng.uniform();
+    Vec3 local = sampleCosineHemisphere(uTheta, uPhi);
     Ray ray{sp.position + sp.geometricNormal * scene.rayEpsilon(), Frame::fromNormal(sp.geometricNormal).toWorld(local)};
     intersector.intersect(ray, INFINITY, hit);
   }

@@ -76,9 +76,13 @@ __global__ void cellKeysKernel(HashGridView grid, const Photon* photons, uint32_
   atomicAdd(cellCounts + key, 1u);
 }
 
-__global__ void gatherPhotonsKernel(const Photon* photons, const uint32_t* order, uint32_t n, Photon* sorted) {
+__global__ void gatherPhotonsKernel(const Photon* photons, const uint32_t* order, uint32_t n, Photon* sorted,
+                                    PackedPosition* positions) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) sorted[i] = photons[order[i]];
+  if (i >= n) return;
+  Photon p = photons[order[i]];
+  sorted[i] = p;
+  positions[i] = {p.position.x, p.position.y, p.position.z, 0.0f};
 }
 
 int bitsFor(uint64_t values) {
@@ -94,6 +98,7 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   size_t vertexCount = scene.vertices().size();
   vertices.upload(scene.vertices().data(), vertexCount, "scene vertices");
   if (host.normals) normals.upload(host.normals, vertexCount, "scene normals");
+  faceNormals.upload(scene.faceNormals().data(), scene.faceNormals().size(), "face normals");
   indices.upload(host.indices, 3 * size_t(host.triangleCount), "scene indices");
   materialIds.upload(host.materialIds, host.triangleCount, "material ids");
   materials.upload(scene.materials().data(), scene.materials().size(), "materials");
@@ -105,6 +110,7 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   view = host;
   view.vertices = vertices.data();
   view.normals = host.normals ? normals.data() : nullptr;
+  view.faceNormals = faceNormals.data();
   view.indices = indices.data();
   view.materialIds = materialIds.data();
   view.materials = materials.data();
@@ -173,7 +179,7 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
 
 size_t GpuHashGrid::memoryBytes() const {
   return keys_[0].bytes() + keys_[1].bytes() + values_[0].bytes() + values_[1].bytes() + counts_.bytes() +
-         cellStart_.bytes() + sorted_.bytes() + temp_.bytes();
+         cellStart_.bytes() + sorted_.bytes() + positions_.bytes() + temp_.bytes();
 }
 
 void GpuHashGrid::build(const Photon* photons, uint32_t count, const Bounds3& bounds, float radius,
@@ -188,6 +194,7 @@ void GpuHashGrid::build(const Photon* photons, uint32_t count, const Bounds3& bo
   counts_.reserve(cellCount_ + 1, "hash-grid cell counts");
   cellStart_.reserve(cellCount_ + 1, "hash-grid startIdx");
   sorted_.reserve(n, "hash-grid photons");
+  positions_.reserve(n, "hash-grid positions");
   int endBit = bitsFor(cellCount_);
   cub::DoubleBuffer<uint32_t> keys(keys_[0].data(), keys_[1].data()), values(values_[0].data(), values_[1].data());
   size_t sortBytes = 0, scanBytes = 0;
@@ -209,10 +216,12 @@ void GpuHashGrid::build(const Photon* photons, uint32_t count, const Bounds3& bo
     bytes = temp_.capacity();
     PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, keys, values, int(count), 0, endBit, stream));
     sortedBuffer_ = keys.selector;
-    gatherPhotonsKernel<<<blocksFor(count, 256), 256, 0, stream>>>(photons, values.Current(), count, sorted_.data());
+    gatherPhotonsKernel<<<blocksFor(count, 256), 256, 0, stream>>>(photons, values.Current(), count, sorted_.data(),
+                                                                   positions_.data());
     PVR_CUDA_CHECK_LAUNCH("gatherPhotons");
   }
   view_.photons = sorted_.data();
+  view_.positions = positions_.data();
   view_.cellStart = cellStart_.data();
   view_.photonCount = count;
 }

@@ -15,7 +15,7 @@
 namespace pvr::cuda {
 
 struct DeviceScene {
-  DeviceBuffer<Vec3> vertices, normals;
+  DeviceBuffer<Vec3> vertices, normals, faceNormals;
   DeviceBuffer<uint32_t> indices, materialIds, lightTriangles;
   DeviceBuffer<Material> materials;
   DeviceBuffer<float> lightCdf;
@@ -64,6 +64,7 @@ class GpuHashGrid {
  private:
   DeviceBuffer<uint32_t> keys_[2], values_[2], counts_, cellStart_;
   DeviceBuffer<Photon> sorted_;
+  DeviceBuffer<PackedPosition> positions_;
   DeviceBuffer<unsigned char> temp_;
   HashGridView view_;
   uint64_t cellCount_ = 0;

@@ -75,19 +75,23 @@ HashGrid HashGrid::build(const std::vector<Photon>& input, float radius) {
     grid.photons_[dst] = input[i];
     grid.sortedToInput_[dst] = i;
   }
+  grid.positions_.resize(input.size());
+  for (size_t i = 0; i < input.size(); ++i)
+    grid.positions_[i] = {grid.photons_[i].position.x, grid.photons_[i].position.y, grid.photons_[i].position.z, 0.0f};
   return grid;
 }
 
 HashGridView HashGrid::view() const {
   HashGridView v = layout_;
   v.photons = photons_.data();
+  v.positions = positions_.data();
   v.cellStart = cellStart_.data();
   v.photonCount = uint32_t(photons_.size());
   return v;
 }
 
 size_t HashGrid::memoryBytes() const {
-  return photons_.size() * sizeof(Photon) + cellStart_.size() * sizeof(uint32_t);
+  return photons_.size() * (sizeof(Photon) + sizeof(PackedPosition)) + cellStart_.size() * sizeof(uint32_t);
 }
 
 }  // namespace pvr

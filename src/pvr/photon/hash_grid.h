@@ -14,8 +14,14 @@
 
 namespace pvr {
 
+// A photon's position padded to 16 bytes: the search loop reads it with one vector load.
+struct alignas(16) PackedPosition {
+  float x, y, z, pad;
+};
+
 struct HashGridView {
   const Photon* photons = nullptr;      ///< sorted by cell
+  const PackedPosition* positions = nullptr;  ///< photons[i].position, for the search loop
   const uint32_t* cellStart = nullptr;  ///< cellCount + 1 entries
   uint32_t photonCount = 0;
   Vec3 origin;
@@ -41,6 +47,15 @@ struct HashGridView {
     return int64_t(hash(c[0], c[1], c[2]));
   }
 
+  PVR_HOST_DEVICE Vec3 position(uint32_t i) const {
+#ifdef __CUDA_ARCH__
+    float4 p = __ldg(reinterpret_cast<const float4*>(positions + i));
+    return {p.x, p.y, p.z};
+#else
+    return {positions[i].x, positions[i].y, positions[i].z};
+#endif
+  }
+
   // Visits every photon with photonDistance2 <= r2, where r2 <= cellSize^2. `visit(index, d2, r2)`
   // may shrink r2 (kNN); the index is into `photons`.
   template <class Visitor>
@@ -52,7 +67,7 @@ struct HashGridView {
       uint32_t first = uint32_t(center + rowOffsets[row]);
       uint32_t end = cellStart[first + 3];
       for (uint32_t i = cellStart[first]; i < end; ++i) {
-        float d2 = photonDistance2(q, photons[i].position);
+        float d2 = photonDistance2(q, position(i));
         if (d2 <= r2) visit(i, d2, r2);
       }
     }
@@ -76,6 +91,7 @@ class HashGrid {
 
  private:
   std::vector<Photon> photons_;
+  std::vector<PackedPosition> positions_;
   std::vector<uint32_t> cellStart_;
   std::vector<uint32_t> sortedToInput_;
   HashGridView layout_;  ///< geometry of the grid, pointers filled by view()

@@ -27,7 +27,10 @@ PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTra
   CounterRng rng(params.seed, i, 0);
   float uPick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
   LightSample ls = sampleLight(scene, uPick, u1, u2);
-  Vec3 local = sampleCosineHemisphere(rng.uniform(), rng.uniform());
+  // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+  float uTheta = rng.uniform();
+  float uPhi = rng.uniform();
+  Vec3 local = sampleCosineHemisphere(uTheta, uPhi);
   Photon p;
   p.position = ls.position;
   p.direction = Frame::fromNormal(ls.normal).toWorld(local);
@@ -65,7 +68,10 @@ PVR_HOST_DEVICE int tracePhoton(const SceneView& scene, const Intersector& inter
       float survive = fminf(1.0f, maxComponent(m.albedo));
       if (!(rng.uniform() < survive)) break;
       photon.power *= m.albedo * (1.0f / survive);
-      Vec3 local = sampleCosineHemisphere(rng.uniform(), rng.uniform());
+      // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+      float uTheta = rng.uniform();
+      float uPhi = rng.uniform();
+      Vec3 local = sampleCosineHemisphere(uTheta, uPhi);
       ray.dir = Frame::fromNormal(nShade).toWorld(local);
       if (dot(ray.dir, nFacing) <= 0.0f) break;  // shading normal sent it below the surface
       offsetNormal = nFacing;

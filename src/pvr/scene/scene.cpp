@@ -45,6 +45,14 @@ void Scene::addMesh(const std::string& meshName, const std::vector<Vec3>& vertic
 void Scene::finalize() {
   if (triangleCount() == 0) throw Error("scene '" + name + "' has no valid triangles");
   // Normals of a mesh without them stay zero: surfacePoint then falls back to the geometric one.
+  // Face normals computed once here: the CUDA backend reads the same bits instead of recomputing
+  // them with fused multiply-adds, whose tiny +/- residue on axis-aligned faces would flip the
+  // sign-dependent tangent frame of Frame::fromNormal and send photons on different paths.
+  faceNormals_.resize(triangleCount());
+  for (uint32_t t = 0; t < triangleCount(); ++t) {
+    Vec3 a = vertices_[indices_[3 * t]], b = vertices_[indices_[3 * t + 1]], c = vertices_[indices_[3 * t + 2]];
+    faceNormals_[t] = normalize(cross(b - a, c - a));
+  }
   lightTriangles_.clear();
   lightCdf_.assign(1, 0.0f);
   SceneView v = view();
@@ -65,6 +73,7 @@ SceneView Scene::view() const {
   SceneView v;
   v.vertices = vertices_.data();
   v.normals = normals_.empty() ? nullptr : normals_.data();
+  v.faceNormals = faceNormals_.empty() ? nullptr : faceNormals_.data();
   v.indices = indices_.data();
   v.materialIds = materialIds_.data();
   v.materials = materials_.data();

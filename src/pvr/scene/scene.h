@@ -41,6 +41,7 @@ class Scene {
 
   const std::vector<Vec3>& vertices() const { return vertices_; }
   const std::vector<uint32_t>& indices() const { return indices_; }
+  const std::vector<Vec3>& faceNormals() const { return faceNormals_; }
 
   StereoRig rig = defaultRig();
   std::string name;
@@ -48,6 +49,7 @@ class Scene {
  private:
   std::vector<Vec3> vertices_;
   std::vector<Vec3> normals_;  // empty if no mesh has normals
+  std::vector<Vec3> faceNormals_;  // one per triangle, by winding (finalize)
   std::vector<uint32_t> indices_;
   std::vector<uint32_t> materialIds_;
   std::vector<Material> materials_;

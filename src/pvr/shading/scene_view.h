@@ -26,6 +26,7 @@ struct SurfacePoint {
 struct SceneView {
   const Vec3* vertices = nullptr;
   const Vec3* normals = nullptr;  ///< per vertex, or null
+  const Vec3* faceNormals = nullptr;  ///< per triangle, unit, by winding; null: computed on the fly
   const uint32_t* indices = nullptr;  ///< 3 per triangle
   const uint32_t* materialIds = nullptr;
   const Material* materials = nullptr;
@@ -43,13 +44,17 @@ struct SceneView {
     c = vertices[indices[3 * prim + 2]];
   }
 
+  PVR_HOST_DEVICE Vec3 faceNormal(uint32_t prim, Vec3 a, Vec3 b, Vec3 c) const {
+    return faceNormals ? faceNormals[prim] : normalize(cross(b - a, c - a));
+  }
+
   PVR_HOST_DEVICE SurfacePoint surfacePoint(const Hit& hit) const {
     Vec3 a, b, c;
     triangle(hit.primId, a, b, c);
     float w = 1.0f - hit.u - hit.v;
     SurfacePoint sp;
     sp.position = a * w + b * hit.u + c * hit.v;
-    sp.geometricNormal = normalize(cross(b - a, c - a));
+    sp.geometricNormal = faceNormal(hit.primId, a, b, c);
     sp.shadingNormal = sp.geometricNormal;
     if (normals) {
       Vec3 n = normals[indices[3 * hit.primId]] * w + normals[indices[3 * hit.primId + 1]] * hit.u +
@@ -88,11 +93,10 @@ PVR_HOST_DEVICE inline LightSample sampleLight(const SceneView& s, float uPick, 
   Vec3 a, b, c;
   s.triangle(prim, a, b, c);
   Vec2 bc = sampleTriangleBarycentrics(u1, u2);
-  Vec3 n = cross(b - a, c - a);
-  float area = 0.5f * length(n);
+  float area = 0.5f * length(cross(b - a, c - a));
   LightSample ls;
   ls.position = a * (1.0f - bc.x - bc.y) + b * bc.x + c * bc.y;
-  ls.normal = n / (2.0f * area);
+  ls.normal = s.faceNormal(prim, a, b, c);
   ls.emission = s.material(prim).emission;
   float pick = (s.lightCdf[i + 1] - s.lightCdf[i]) / s.lightCdf[s.lightCount];
   ls.pdfArea = pick / area;
