@@ -8,10 +8,10 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
+#include "bench_util.h"
 #include "pvr/util/error.h"
 #ifdef PVR_HAVE_CUDA
 #include "pvr/cuda/cuda_renderer.h"
@@ -77,13 +77,15 @@ std::vector<Table> paperTables() {
   return t;
 }
 
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  if (out.empty()) throw Error("empty list '" + s + "'");
-  return out;
+// The scene's rig, at --eye-size if given.
+StereoRig benchRig(const Scene& scene, const FrameBenchArgs& args) {
+  StereoRig rig = scene.rig;
+  if (args.eyeSize.empty()) return rig;
+  int w = 0, h = 0;
+  if (std::sscanf(args.eyeSize.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+    throw Error("--eye-size must be WxH between 1x1 and 8192x8192, got '" + args.eyeSize + "'");
+  rig.width = w, rig.height = h;
+  return rig;
 }
 
 // Mean absolute difference relative to the mean (over RGB), and the fraction of pixels that
@@ -226,12 +228,7 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
               "diffuse Mrays/s | check vs Embree |\n|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& name : splitList(args.raysScene)) {
     Scene scene = loadScene(name);
-    StereoRig rig = scene.rig;
-    if (!args.eyeSize.empty()) {
-      int w = 0, h = 0;
-      if (std::sscanf(args.eyeSize.c_str(), "%dx%d", &w, &h) != 2) throw Error("--eye-size must be WxH");
-      rig.width = w, rig.height = h;
-    }
+    StereoRig rig = benchRig(scene, args);
     CudaFrameRenderer gpu(scene);
     GpuRayThroughput t = gpu.measureRays(rig, 20);
     // Check: the left eye's pixel-centre hits against Embree on the CPU, every 13th pixel.
@@ -307,10 +304,7 @@ int runFrameBench(const FrameBenchArgs& args) {
   if (args.frames < 1 || args.frames > 100000) throw Error("--frames must be between 1 and 100000");
   if (args.warmup < 0 || args.warmup > 100000) throw Error("--warmup must be between 0 and 100000");
   if (args.k < 1 || args.k > kMaxKnn) throw Error("--k must be between 1 and " + std::to_string(kMaxKnn));
-  BackendKind kind = args.backend == "cpu" ? BackendKind::Cpu
-                     : args.backend == "cuda" ? BackendKind::Cuda
-                     : args.backend == "auto" ? BackendKind::Auto
-                                              : throw Error("--backend must be cpu, cuda or auto, got '" + args.backend + "'");
+  BackendKind kind = parseBackendKind(args.backend);
   bool gpuSuite = args.suite == "rays" || args.suite == "grid" || args.suite == "all";
   std::string why;
   if (gpuSuite && (kind == BackendKind::Cpu || !cudaBackendAvailable(&why)))
@@ -320,13 +314,7 @@ int runFrameBench(const FrameBenchArgs& args) {
   int failures = 0;
   if (args.suite == "tables" || args.suite == "all") {
     Scene scene = loadScene(args.scene);
-    StereoRig rig = scene.rig;
-    if (!args.eyeSize.empty()) {
-      int w = 0, h = 0;
-      if (std::sscanf(args.eyeSize.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-        throw Error("--eye-size must be WxH between 1x1 and 8192x8192, got '" + args.eyeSize + "'");
-      rig.width = w, rig.height = h;
-    }
+    StereoRig rig = benchRig(scene, args);
     std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
     failures += runTables(args, scene, *renderer, rig, json);
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "pvr/cpu/cpu_backend.h"
+#include "bench_util.h"
 #include "pvr/util/error.h"
 
 namespace pvr {
@@ -28,15 +29,6 @@ double minTimeMs(int repeats, F&& f) {
     best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
   return best;
-}
-
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  if (out.empty()) throw Error("empty list '" + s + "'");
-  return out;
 }
 
 uint32_t parseGrid(const std::string& s, uint32_t& nx, uint32_t& ny) {

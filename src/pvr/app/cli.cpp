@@ -135,15 +135,8 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   return o;
 }
 
-BackendKind parseBackend(const std::string& text) {
-  if (text == "cpu") return BackendKind::Cpu;
-  if (text == "cuda") return BackendKind::Cuda;
-  if (text == "auto") return BackendKind::Auto;
-  throw Error("--backend must be cpu, cuda or auto, got '" + text + "'");
-}
-
 int runRender(const RenderArgs& a) {
-  BackendKind backendKind = parseBackend(a.backend);
+  BackendKind backendKind = parseBackendKind(a.backend);
   Scene scene = loadScene(a.scene);
   StereoRig rig = scene.rig;
   RenderOptions options = toOptions(a, rig);

@@ -29,11 +29,7 @@ std::string CpuFrameRenderer::deviceName() const {
 FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const RenderOptions& options) {
   validateOptions(options, rig);
   FrameResult frame;
-  PhotonTraceParams traceParams;
-  traceParams.photonCount = options.photonCount();
-  traceParams.seed = options.gather.seed;
-  traceParams.maxDepth = options.maxPhotonDepth;
-  traceParams.storeDirect = options.gather.mode == ShadingMode::PhotonMapOnly;
+  PhotonTraceParams traceParams = options.photonTraceParams();
 
   auto start = std::chrono::steady_clock::now();
   std::vector<Photon> photons = backend.tracePhotons(traceParams);

@@ -39,7 +39,8 @@ class CudaFrameRenderer : public FrameRenderer {
   // Pieces of the pipeline, for tests and benchmarks.
   std::vector<Photon> tracePhotons(const PhotonTraceParams& params);
   // Builds the hash grid over `photons` on the GPU `repeats` times; returns the median build time
-  // in ms (CUDA events, keys to gathered photons, the bounds included) and optionally the grid.
+  // in ms (CUDA events, cell keys to gathered photons; the photons' bounds are given, as the
+  // tracer reduces them while tracing) and optionally the grid.
   double buildHashGrid(const std::vector<Photon>& photons, float radius, int repeats, GpuHashGridCopy* copy = nullptr);
   GpuRayThroughput measureRays(const StereoRig& rig, int repeats);
   const BvhBuildStats& bvhStats() const;

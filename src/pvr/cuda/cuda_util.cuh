@@ -103,6 +103,13 @@ class EventTimer {
   cudaEvent_t start_ = nullptr, stop_ = nullptr;
 };
 
+// Key bits a radix sort needs for keys in [0, values).
+inline int radixBitsFor(uint64_t values) {
+  int bits = 1;
+  while (bits < 32 && (uint64_t(1) << bits) < values) ++bits;
+  return bits;
+}
+
 inline unsigned blocksFor(size_t n, unsigned threads) { return unsigned((n + threads - 1) / threads); }
 
 }  // namespace pvr::cuda

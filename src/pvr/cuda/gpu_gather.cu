@@ -199,12 +199,6 @@ __global__ void diffuseRaysKernel(SceneView scene, BvhIntersector intersector, E
   out[pixel] = hit;
 }
 
-int bitsFor(uint64_t values) {
-  int bits = 1;
-  while (bits < 32 && (uint64_t(1) << bits) < values) ++bits;
-  return bits;
-}
-
 template <Estimator E, class Map>
 void launchSingle(const DeviceScene& scene, const Map& map, const GatherParams& params, const EyeCamera& camera,
                   Eye eye, Vec3* image, uint32_t* firstPrim, cudaStream_t stream) {
@@ -266,7 +260,7 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
       sortValues_[b].reserve(pixels, "gather-point order");
     }
     noCell = uint32_t(uint64_t(map.grid->dims[0]) * map.grid->dims[1] * map.grid->dims[2]);
-    endBit = bitsFor(uint64_t(noCell) + 1);
+    endBit = radixBitsFor(uint64_t(noCell) + 1);
     size_t bytes = 0;
     cub::DoubleBuffer<uint32_t> k(sortKeys_[0].data(), sortKeys_[1].data()), v(sortValues_[0].data(), sortValues_[1].data());
     PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, k, v, int(pixels), 0, endBit, stream));

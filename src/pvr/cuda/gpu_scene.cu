@@ -85,12 +85,6 @@ __global__ void gatherPhotonsKernel(const Photon* photons, const uint32_t* order
   positions[i] = {p.position.x, p.position.y, p.position.z, 0.0f};
 }
 
-int bitsFor(uint64_t values) {
-  int bits = 1;
-  while (bits < 32 && (uint64_t(1) << bits) < values) ++bits;
-  return bits;
-}
-
 }  // namespace
 
 void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
@@ -195,7 +189,7 @@ void GpuHashGrid::build(const Photon* photons, uint32_t count, const Bounds3& bo
   cellStart_.reserve(cellCount_ + 1, "hash-grid startIdx");
   sorted_.reserve(n, "hash-grid photons");
   positions_.reserve(n, "hash-grid positions");
-  int endBit = bitsFor(cellCount_);
+  int endBit = radixBitsFor(cellCount_);
   cub::DoubleBuffer<uint32_t> keys(keys_[0].data(), keys_[1].data()), values(values_[0].data(), values_[1].data());
   size_t sortBytes = 0, scanBytes = 0;
   PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sortBytes, keys, values, int(n), 0, endBit, stream));

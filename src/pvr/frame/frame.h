@@ -8,6 +8,7 @@
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/frame/image.h"
 #include "pvr/photon/gather.h"
+#include "pvr/photon/photon_trace.h"
 
 namespace pvr {
 
@@ -32,6 +33,15 @@ struct RenderOptions {
   GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
   bool eyes[2] = {true, true};
   uint32_t photonCount() const { return photonsX * photonsY; }
+  // The photon pass these options ask for (every backend traces the same photons).
+  PhotonTraceParams photonTraceParams() const {
+    PhotonTraceParams p;
+    p.photonCount = photonCount();
+    p.seed = gather.seed;
+    p.maxDepth = maxPhotonDepth;
+    p.storeDirect = gather.mode == ShadingMode::PhotonMapOnly;  // the map alone then shades
+    return p;
+  }
 };
 
 struct StageTimings {

@@ -7,6 +7,13 @@
 
 namespace pvr {
 
+BackendKind parseBackendKind(const std::string& text) {
+  if (text == "cpu") return BackendKind::Cpu;
+  if (text == "cuda") return BackendKind::Cuda;
+  if (text == "auto") return BackendKind::Auto;
+  throw Error("--backend must be cpu, cuda or auto, got '" + text + "'");
+}
+
 bool cudaBackendAvailable(std::string* why) {
 #ifdef PVR_HAVE_CUDA
   return cudaDeviceUsable(why);

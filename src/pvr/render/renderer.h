@@ -10,6 +10,9 @@ namespace pvr {
 
 enum class BackendKind : int { Cpu = 0, Cuda = 1, Auto = 2 };
 
+// "cpu" | "cuda" | "auto"; throws pvr::Error naming --backend otherwise.
+BackendKind parseBackendKind(const std::string& text);
+
 // True if this build has the CUDA backend and a CUDA GPU is usable; otherwise `why` says why not.
 bool cudaBackendAvailable(std::string* why = nullptr);
 

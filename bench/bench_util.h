@@ -1,0 +1,21 @@
+#pragma once
+// Small pieces shared by the benchmark harnesses.
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "pvr/util/error.h"
+
+namespace pvr {
+
+// "a,b,c" -> {"a", "b", "c"}; throws pvr::Error for an empty list.
+inline std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  if (out.empty()) throw Error("empty list '" + s + "'");
+  return out;
+}
+
+}  // namespace pvr
