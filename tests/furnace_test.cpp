@@ -30,7 +30,7 @@ Vec3 meanRadiance(const CpuBackend& backend, const HashGridView& map, const Gath
     for (int a = 0; a < 3; ++a) nearEdge += std::abs(p[a]) > 0.5f - margin;
     if (nearEdge > 1) continue;
     CounterRng counter(params.seed, i, 0);
-    sum += radianceAlongRay(view, backend.intersector(), map, params, ray, counter, nullptr);
+    sum += radianceAlongRay(view, backend.intersector(), map, params, ray, counter);
     ++used;
   }
   return sum / float(used);

@@ -51,6 +51,7 @@ struct RenderArgs {
   std::string estimator = "radius";
   std::string kernel = "hybrid";
   std::string backend = "auto";
+  std::string stereo = "separate";
   int k = 32;
   std::string eyes = "both";
   std::string eyeSize;  // empty: the scene's rig (1440x1600 for built-in scenes)
@@ -79,6 +80,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
       ->capture_default_str();
   cmd.add_option("--backend", a.backend, "cpu (Embree + TBB reference) | cuda | auto (cuda if a GPU is present)")
       ->capture_default_str();
+  cmd.add_option("--stereo", a.stereo,
+                 "Right eye: separate (shaded on its own) | scatter (the paper's: left hit points projected into the "
+                 "right image) | gather (ours: right hits looked up in the left image); reuse is for diffuse surfaces only")
+      ->capture_default_str();
   cmd.add_option("--seed", a.seed, "Seed of the counter-based random numbers")->capture_default_str();
   cmd.add_option("--photon-depth", a.photonDepth, "Maximum surface interactions per photon path")->capture_default_str();
 }
@@ -106,6 +111,7 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   else if (a.kernel == "shared") o.kernel = DensityKernel::SharedMemory;
   else if (a.kernel == "sorted") o.kernel = DensityKernel::CellSorted;
   else throw Error("--kernel must be single, hybrid, shared or sorted, got '" + a.kernel + "'");
+  o.stereo = parseStereoMode(a.stereo);
   if (a.eyes == "both") o.eyes[0] = o.eyes[1] = true;
   else if (a.eyes == "left") o.eyes[0] = true, o.eyes[1] = false;
   else if (a.eyes == "right") o.eyes[0] = false, o.eyes[1] = true;
@@ -156,10 +162,19 @@ int runRender(const RenderArgs& a) {
   std::printf("  photon trace  %9.2f ms  (%zu photons stored)\n", frame.timings.photonTraceMs, frame.storedPhotons);
   std::printf("  map build     %9.2f ms  (%.1f MiB)\n", frame.timings.mapBuildMs, frame.mapBytes / 1048576.0);
   const char* names[2] = {"left", "right"};
-  for (int e = 0; e < 2; ++e)
-    if (options.eyes[e])
-      std::printf("  %-5s eye     %9.2f ms  (eye rays %.2f, density %.2f)\n", names[e], frame.timings.eyeMs[e],
-                  frame.timings.eyeRayMs[e], frame.timings.densityMs[e]);
+  for (int e = 0; e < 2; ++e) {
+    if (!options.eyes[e]) continue;
+    std::printf("  %-5s eye     %9.2f ms  (eye rays %.2f, density %.2f", names[e], frame.timings.eyeMs[e],
+                frame.timings.eyeRayMs[e], frame.timings.densityMs[e]);
+    if (e == 1 && options.stereo == StereoMode::Scatter) std::printf(", scatter %.2f", frame.timings.scatterMs);
+    std::printf(")\n");
+  }
+  if (options.stereo != StereoMode::Separate) {
+    double pixels = double(rig.width) * rig.height;
+    std::printf("  stereo %s: right eye reused %.1f%% of its pixels from the left; right/left time %.2f\n",
+                stereoModeName(options.stereo), 100.0 * double(frame.reusedPixels) / pixels,
+                frame.timings.eyeMs[0] > 0 ? frame.timings.eyeMs[1] / frame.timings.eyeMs[0] : 0.0);
+  }
   if (frame.deviceBytes) std::printf("  GPU memory    %9.1f MiB\n", frame.deviceBytes / 1048576.0);
   std::printf("  total         %9.2f ms\n", frame.timings.totalMs());
   std::filesystem::path prefix(a.out);

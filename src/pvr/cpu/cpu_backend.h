@@ -18,11 +18,17 @@ class CpuBackend {
   // Traces params.photonCount photons; stored photons come out in photon-index order.
   std::vector<Photon> tracePhotons(const PhotonTraceParams& params) const;
 
-  // Shades every pixel of one eye into `out` (width * height entries, row-major, top row first).
+  // Shades every pixel of one eye into `out` (width * height entries, row-major, top row first),
+  // taking the other eye's shading where `reuse` allows.
   void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
-                 PixelSample* out) const;
+                 PixelSample* out, const StereoReuseView& reuse = StereoReuseView()) const;
   void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                 PixelSample* out) const;
+                 PixelSample* out, const StereoReuseView& reuse = StereoReuseView()) const;
+
+  // Scatter: projects every reusable source pixel's surface into `target`'s image, keeping the
+  // nearest per target pixel in `scattered` (width * height entries, filled with kNothingScattered
+  // here). Returns the number of source points written.
+  size_t scatter(const PixelSample* source, size_t sourcePixels, const EyeCamera& target, uint64_t* scattered) const;
 
   const Scene& scene() const { return scene_; }
   const EmbreeIntersector& intersector() const { return intersector_; }
@@ -30,7 +36,7 @@ class CpuBackend {
  private:
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                     PixelSample* out) const;
+                     PixelSample* out, const StereoReuseView& reuse) const;
   const Scene& scene_;
   EmbreeIntersector intersector_;
 };

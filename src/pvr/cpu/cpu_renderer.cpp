@@ -48,23 +48,50 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
   }
   frame.timings.mapBuildMs = msSince(start);
 
+  // The left eye first: under stereo reuse the right eye reads its surfaces and finished image.
+  std::vector<PixelSample> samples[2];
+  std::vector<uint64_t> scattered;
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;
     EyeCamera camera = rig.eye(Eye(e));
-    std::vector<PixelSample> samples(size_t(camera.width) * camera.height);
-    start = std::chrono::steady_clock::now();
-    if (options.map == PhotonMapKind::HashGrid)
-      backend.renderEye(camera, Eye(e), options.gather, grid.view(), samples.data());
-    else
-      backend.renderEye(camera, Eye(e), options.gather, tree.view(), samples.data());
-    frame.timings.eyeMs[e] = msSince(start);
-    frame.timings.eyeRayMs[e] = frame.timings.eyeMs[e];  // one fused pass, like the single kernel
+    samples[e].resize(size_t(camera.width) * camera.height);
     EyeResult& out = frame.eyes[e];
+    StereoReuseView reuse;
+    std::vector<SurfaceRecord> sourceSurfaces;
+    if (e == 1 && options.stereo != StereoMode::Separate) {
+      reuse.mode = options.stereo;
+      reuse.source = rig.eye(Eye::Left);
+      sourceSurfaces.resize(samples[0].size());  // the layout the shared code reads (untimed copy)
+      for (size_t i = 0; i < samples[0].size(); ++i) sourceSurfaces[i] = samples[0][i].surface;
+      reuse.sourceSurfaces = sourceSurfaces.data();
+      reuse.sourceImage = frame.eyes[0].image.pixels.data();
+    }
+    start = std::chrono::steady_clock::now();
+    if (reuse.mode == StereoMode::Scatter) {
+      scattered.resize(samples[1].size());
+      backend.scatter(samples[0].data(), samples[0].size(), camera, scattered.data());
+      reuse.scattered = scattered.data();
+      frame.timings.scatterMs = msSince(start);
+    }
+    auto eyeStart = std::chrono::steady_clock::now();
+    if (options.map == PhotonMapKind::HashGrid)
+      backend.renderEye(camera, Eye(e), options.gather, grid.view(), samples[e].data(), reuse);
+    else
+      backend.renderEye(camera, Eye(e), options.gather, tree.view(), samples[e].data(), reuse);
+    frame.timings.eyeRayMs[e] = msSince(eyeStart);  // one fused pass, like the single kernel
+    frame.timings.eyeMs[e] = msSince(start);
     out.image = Image(camera.width, camera.height);
-    out.firstPrim.resize(samples.size());
-    for (size_t i = 0; i < samples.size(); ++i) {
-      out.image.pixels[i] = samples[i].radiance;
-      out.firstPrim[i] = samples[i].firstPrim;
+    out.firstPrim.resize(samples[e].size());
+    for (size_t i = 0; i < samples[e].size(); ++i) {
+      out.image.pixels[i] = samples[e][i].radiance;
+      out.firstPrim[i] = samples[e][i].firstPrim;
+    }
+    if (reuse.reusing()) {
+      out.reusedFrom.resize(samples[e].size());
+      for (size_t i = 0; i < samples[e].size(); ++i) {
+        out.reusedFrom[i] = samples[e][i].reusedFrom;
+        frame.reusedPixels += out.reusedFrom[i] != kNotReused ? 1 : 0;
+      }
     }
   }
   return frame;

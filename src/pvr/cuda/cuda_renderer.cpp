@@ -29,7 +29,7 @@ struct CudaFrameRenderer::Impl {
   cuda::GpuHashGrid grid;
   cuda::GpuKdTree tree;
   cuda::GpuGather gather;
-  cuda::EventTimer traceTimer, buildTimer;
+  cuda::EventTimer traceTimer, buildTimer, scatterTimer;
   cuda::EyeTimers eyeTimers[2];
   cudaDeviceProp properties{};
 
@@ -89,11 +89,20 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
     frame.mapBytes = m.tree.memoryBytes();
   }
 
-  for (int e = 0; e < 2; ++e) {
+  unsigned reused = 0;
+  for (int e = 0; e < 2; ++e) {  // the left eye first: the right eye may reuse it
     if (!options.eyes[e]) continue;
-    m.gather.renderEye(m.deviceScene, map, options, rig.eye(Eye(e)), Eye(e), m.stream, m.eyeTimers[e]);
+    if (e == 1 && options.stereo == StereoMode::Scatter) {
+      m.scatterTimer.start(m.stream);
+      m.gather.scatter(m.deviceScene, rig, m.stream);
+      m.scatterTimer.stop(m.stream);
+    }
+    m.gather.renderEye(m.deviceScene, map, options, rig, Eye(e), m.stream, m.eyeTimers[e]);
   }
+  if (options.stereo != StereoMode::Separate) m.gather.downloadReusedCount(&reused, m.stream);
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  frame.reusedPixels = reused;
+  if (options.stereo == StereoMode::Scatter) frame.timings.scatterMs = m.scatterTimer.ms();
   frame.timings.photonTraceMs = m.traceTimer.ms();
   frame.timings.mapBuildMs = options.map == PhotonMapKind::HashGrid ? m.buildTimer.ms() : kdMs;
   for (int e = 0; e < 2; ++e) {
@@ -102,6 +111,7 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
     frame.timings.densityMs[e] = m.eyeTimers[e].densityMs();
     frame.timings.eyeMs[e] = frame.timings.eyeRayMs[e] + frame.timings.densityMs[e];
   }
+  frame.timings.eyeMs[1] += frame.timings.scatterMs;
   frame.deviceBytes = cuda::deviceBytesInUse();
 
   if (images) {
@@ -114,6 +124,11 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
                                      cudaMemcpyDeviceToHost, m.stream));
       PVR_CUDA_CHECK(cudaMemcpyAsync(out.firstPrim.data(), m.gather.firstPrim(Eye(e)), out.firstPrim.size() * sizeof(uint32_t),
                                      cudaMemcpyDeviceToHost, m.stream));
+      if (e == 1 && options.stereo != StereoMode::Separate) {
+        out.reusedFrom.resize(out.firstPrim.size());
+        PVR_CUDA_CHECK(cudaMemcpyAsync(out.reusedFrom.data(), m.gather.reusedFrom(), out.reusedFrom.size() * sizeof(uint32_t),
+                                       cudaMemcpyDeviceToHost, m.stream));
+      }
     }
     PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
   }

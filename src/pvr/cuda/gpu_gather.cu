@@ -25,30 +25,55 @@ __device__ inline void storeSample(Vec3* image, size_t pixel, Vec3 c, int sample
   image[pixel] = v;
 }
 
+// Everything of a pixel but its radiance: first-hit id, the surface the right eye may reuse, and
+// the reuse decision (counted per warp: one atomic per warp, not per pixel).
+__device__ inline void recordPixel(const EyeOutputs& out, size_t pixel, const PixelSample& p) {
+  out.firstPrim[pixel] = p.firstPrim;
+  if (out.surfaces) out.surfaces[pixel] = p.surface;
+  if (!out.reusedFrom) return;
+  out.reusedFrom[pixel] = p.reusedFrom;
+  unsigned active = __activemask();
+  unsigned reused = __ballot_sync(active, p.reusedFrom != kNotReused);
+  unsigned lane = (threadIdx.y * blockDim.x + threadIdx.x) & 31u;
+  if (lane == unsigned(__ffs(int(active)) - 1) && reused) atomicAdd(out.reusedCount, unsigned(__popc(int(reused))));
+}
+
 // The paper's "single" scheme: eye ray and estimate in one kernel.
 template <class Map, Estimator E>
 __global__ void singleKernel(SceneView scene, BvhIntersector intersector, Map map, GatherParams params,
-                             EyeCamera camera, Eye eye, Vec3* image, uint32_t* firstPrim) {
+                             EyeCamera camera, Eye eye, StereoReuseView reuse, EyeOutputs out) {
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   params.density.estimator = E;  // compile-time estimator: the radius kernel carries no heap
-  PixelSample s = shadePixel(scene, intersector, map, params, camera, eye, x, y);
+  PixelSample s = shadePixel(scene, intersector, map, params, camera, eye, x, y, reuse);
   size_t pixel = size_t(y) * camera.width + x;
-  image[pixel] = s.radiance;
-  firstPrim[pixel] = s.firstPrim;
+  out.image[pixel] = s.radiance;
+  recordPixel(out, pixel, s);
 }
 
-// Hybrid, first kernel: eye rays to their gather points.
+// Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
 __global__ void eyeRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
-                              Eye eye, int sample, GatherPoint* points, uint32_t* firstPrim) {
+                              Eye eye, int sample, StereoReuseView reuse, GatherPoint* points, EyeOutputs out) {
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
-  CounterRng rng(0, 0, 0);
-  Ray ray = pixelSampleRay(params, camera, eye, x, y, sample, rng);
-  uint32_t prim = ~0u;
   size_t pixel = size_t(y) * camera.width + x;
-  points[pixel] = traceToDiffuse(scene, intersector, params, ray, rng, sample == 0 ? &prim : nullptr);
-  if (sample == 0) firstPrim[pixel] = prim;
+  PixelSample state;
+  if (sample > 0 && out.reusedFrom) state.reusedFrom = out.reusedFrom[pixel];  // sample 0 decided
+  points[pixel] = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuse, state);
+  if (sample == 0) recordPixel(out, pixel, state);
+}
+
+// Scatter: each left pixel's reusable surface, if the right eye sees it, lands on one right pixel;
+// the nearest one per pixel wins.
+__global__ void scatterKernel(SceneView scene, BvhIntersector intersector, const SurfaceRecord* surfaces,
+                              int sourceWidth, int sourceHeight, EyeCamera target, unsigned long long* scattered) {
+  int x, y;
+  if (!tilePixel(sourceWidth, sourceHeight, x, y)) return;
+  uint32_t source = uint32_t(y) * uint32_t(sourceWidth) + uint32_t(x);
+  uint32_t pixel;
+  uint64_t entry;
+  if (scatterTarget(scene, intersector, surfaces[source], source, target, pixel, entry))
+    atomicMin(scattered + pixel, static_cast<unsigned long long>(entry));
 }
 
 // Hybrid, second kernel: one estimate per gather point, in the same 8x8 tiles.
@@ -201,9 +226,9 @@ __global__ void diffuseRaysKernel(SceneView scene, BvhIntersector intersector, E
 
 template <Estimator E, class Map>
 void launchSingle(const DeviceScene& scene, const Map& map, const GatherParams& params, const EyeCamera& camera,
-                  Eye eye, Vec3* image, uint32_t* firstPrim, cudaStream_t stream) {
+                  Eye eye, const StereoReuseView& reuse, const EyeOutputs& out, cudaStream_t stream) {
   singleKernel<Map, E><<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
-      scene.view, scene.intersector, map, params, camera, eye, image, firstPrim);
+      scene.view, scene.intersector, map, params, camera, eye, reuse, out);
   PVR_CUDA_CHECK_LAUNCH("single");
 }
 
@@ -217,33 +242,67 @@ void launchDensity(const Map& map, const DensityParams& density, const GatherPoi
 
 template <Estimator E>
 void dispatchSingle(const DeviceScene& scene, DeviceMap map, const GatherParams& params, const EyeCamera& camera,
-                    Eye eye, Vec3* image, uint32_t* firstPrim, cudaStream_t stream) {
-  if (map.grid) launchSingle<E>(scene, *map.grid, params, camera, eye, image, firstPrim, stream);
-  else launchSingle<E>(scene, *map.tree, params, camera, eye, image, firstPrim, stream);
+                    Eye eye, const StereoReuseView& reuse, const EyeOutputs& out, cudaStream_t stream) {
+  if (map.grid) launchSingle<E>(scene, *map.grid, params, camera, eye, reuse, out, stream);
+  else launchSingle<E>(scene, *map.tree, params, camera, eye, reuse, out, stream);
 }
 
 }  // namespace
 
 size_t GpuGather::memoryBytes() const {
-  size_t bytes = points_.bytes() + temp_.bytes();
+  size_t bytes = points_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
+                 reusedCount_.bytes();
   for (int i = 0; i < 2; ++i)
     bytes += images_[i].bytes() + firstPrim_[i].bytes() + sortKeys_[i].bytes() + sortValues_[i].bytes();
   return bytes;
 }
 
-void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options,
-                          const EyeCamera& camera, Eye eye, cudaStream_t stream, EyeTimers& timers) {
+void GpuGather::scatter(const DeviceScene& scene, const StereoRig& rig, cudaStream_t stream) {
+  const size_t pixels = size_t(rig.width) * rig.height;
+  scattered_.reserve(pixels, "scatter buffer");
+  PVR_CUDA_CHECK(cudaMemsetAsync(scattered_.data(), 0xff, pixels * sizeof(uint64_t), stream));  // kNothingScattered
+  scatterKernel<<<tileGrid(rig.width, rig.height), dim3(kTile, kTile), 0, stream>>>(
+      scene.view, scene.intersector, surfaces_.data(), rig.width, rig.height, rig.eye(Eye::Right),
+      reinterpret_cast<unsigned long long*>(scattered_.data()));
+  PVR_CUDA_CHECK_LAUNCH("scatter");
+}
+
+void GpuGather::downloadReusedCount(unsigned* host, cudaStream_t stream) const {
+  PVR_CUDA_CHECK(cudaMemcpyAsync(host, reusedCount_.data(), sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
+}
+
+void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options, const StereoRig& rig,
+                          Eye eye, cudaStream_t stream, EyeTimers& timers) {
+  const EyeCamera camera = rig.eye(eye);
   const size_t pixels = size_t(camera.width) * camera.height;
   const GatherParams& params = options.gather;
   const bool knn = params.density.estimator == Estimator::Knn;
   Vec3* image = (images_[int(eye)].reserve(pixels, "eye image"), images_[int(eye)].data());
-  uint32_t* firstPrim = (firstPrim_[int(eye)].reserve(pixels, "first-hit ids"), firstPrim_[int(eye)].data());
+  EyeOutputs out;
+  out.image = image;
+  out.firstPrim = (firstPrim_[int(eye)].reserve(pixels, "first-hit ids"), firstPrim_[int(eye)].data());
+  StereoReuseView reuse;
+  if (options.stereo != StereoMode::Separate && eye == Eye::Left) {
+    surfaces_.reserve(pixels, "left-eye surfaces");
+    out.surfaces = surfaces_.data();
+  } else if (options.stereo != StereoMode::Separate) {
+    reuse.mode = options.stereo;
+    reuse.source = rig.eye(Eye::Left);
+    reuse.sourceSurfaces = surfaces_.data();
+    reuse.sourceImage = images_[int(Eye::Left)].data();
+    reuse.scattered = options.stereo == StereoMode::Scatter ? scattered_.data() : nullptr;
+    reusedFrom_.reserve(pixels, "reuse sources");
+    reusedCount_.reserve(1, "reuse count");
+    PVR_CUDA_CHECK(cudaMemsetAsync(reusedCount_.data(), 0, sizeof(unsigned), stream));
+    out.reusedFrom = reusedFrom_.data();
+    out.reusedCount = reusedCount_.data();
+  }
 
   if (options.kernel == DensityKernel::Single) {  // shadePixel loops over the samples itself
     timers.prepare(1);
     timers.rays[0]->start(stream);
-    if (knn) dispatchSingle<Estimator::Knn>(scene, map, params, camera, eye, image, firstPrim, stream);
-    else dispatchSingle<Estimator::Radius>(scene, map, params, camera, eye, image, firstPrim, stream);
+    if (knn) dispatchSingle<Estimator::Knn>(scene, map, params, camera, eye, reuse, out, stream);
+    else dispatchSingle<Estimator::Radius>(scene, map, params, camera, eye, reuse, out, stream);
     timers.rays[0]->stop(stream);
     timers.density[0]->start(stream);
     timers.density[0]->stop(stream);
@@ -270,7 +329,7 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
   for (int s = 0; s < params.samplesPerPixel; ++s) {
     timers.rays[s]->start(stream);
     eyeRaysKernel<<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
-        scene.view, scene.intersector, params, camera, eye, s, points_.data(), firstPrim);
+        scene.view, scene.intersector, params, camera, eye, s, reuse, points_.data(), out);
     PVR_CUDA_CHECK_LAUNCH("eyeRays");
     timers.rays[s]->stop(stream);
     timers.density[s]->start(stream);

@@ -39,18 +39,38 @@ struct EyeTimers {
   }
 };
 
+// Per-pixel outputs of an eye pass besides its image (null pointers are not written).
+struct EyeOutputs {
+  Vec3* image = nullptr;
+  uint32_t* firstPrim = nullptr;
+  SurfaceRecord* surfaces = nullptr;  ///< the left eye under stereo reuse
+  uint32_t* reusedFrom = nullptr;     ///< the right eye under stereo reuse
+  unsigned* reusedCount = nullptr;    ///< with reusedFrom: pixels that took the left eye's shading
+};
+
 class GpuGather {
  public:
-  // Shades one eye into image(eye) and firstPrim(eye); times its stages on `timers`.
-  void renderEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options, const EyeCamera& camera,
+  // Shades one eye into image(eye) and firstPrim(eye); times its stages on `timers`. Under stereo
+  // reuse (options.stereo) the left eye records its surfaces and the right eye, rendered after
+  // it (and after scatter() for Scatter), takes the left eye's shading where it may.
+  void renderEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options, const StereoRig& rig,
                  Eye eye, cudaStream_t stream, EyeTimers& timers);
+  // Scatter: projects the left eye's recorded surfaces into the right image (after the left eye).
+  void scatter(const DeviceScene& scene, const StereoRig& rig, cudaStream_t stream);
   const Vec3* image(Eye e) const { return images_[int(e)].data(); }
   const uint32_t* firstPrim(Eye e) const { return firstPrim_[int(e)].data(); }
+  const uint32_t* reusedFrom() const { return reusedFrom_.data(); }
+  // The right eye's reused-pixel count, copied to the host when the stream reaches it.
+  void downloadReusedCount(unsigned* host, cudaStream_t stream) const;
   size_t memoryBytes() const;
 
  private:
   DeviceBuffer<Vec3> images_[2];
   DeviceBuffer<uint32_t> firstPrim_[2];
+  DeviceBuffer<SurfaceRecord> surfaces_;
+  DeviceBuffer<uint64_t> scattered_;
+  DeviceBuffer<uint32_t> reusedFrom_;
+  DeviceBuffer<unsigned> reusedCount_;
   DeviceBuffer<GatherPoint> points_;
   DeviceBuffer<uint32_t> sortKeys_[2], sortValues_[2];
   DeviceBuffer<unsigned char> temp_;

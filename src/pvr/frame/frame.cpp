@@ -20,6 +20,21 @@ const char* densityKernelName(DensityKernel k) {
   return "?";
 }
 
+const char* stereoModeName(StereoMode m) {
+  switch (m) {
+    case StereoMode::Separate: return "separate";
+    case StereoMode::Scatter: return "scatter";
+    case StereoMode::Gather: return "gather";
+  }
+  return "?";
+}
+
+StereoMode parseStereoMode(const std::string& text, const std::string& what) {
+  for (StereoMode m : {StereoMode::Separate, StereoMode::Scatter, StereoMode::Gather})
+    if (text == stereoModeName(m)) return m;
+  throw Error(what + " must be separate, scatter or gather, got '" + text + "'");
+}
+
 void validateOptions(const RenderOptions& o, const StereoRig& rig) {
   if (o.photonsX == 0 || o.photonsY == 0) throw Error("the number of photons must be positive");
   if (uint64_t(o.photonsX) * o.photonsY > (uint64_t(1) << 26))
@@ -40,6 +55,8 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
   if ((o.kernel == DensityKernel::SharedMemory || o.kernel == DensityKernel::CellSorted) &&
       o.map != PhotonMapKind::HashGrid)
     throw Error(std::string("the ") + densityKernelName(o.kernel) + " kernel works on the hash grid, not the kd-tree");
+  if (o.stereo != StereoMode::Separate && !(o.eyes[0] && o.eyes[1]))
+    throw Error(std::string("stereo reuse (") + stereoModeName(o.stereo) + ") renders the right eye from the left: it needs both eyes");
 }
 
 }  // namespace pvr

@@ -24,6 +24,9 @@ enum class DensityKernel : int {
 };
 
 const char* densityKernelName(DensityKernel k);
+const char* stereoModeName(StereoMode m);  ///< "separate" | "scatter" | "gather"
+// "separate" | "scatter" | "gather"; throws pvr::Error naming `what` otherwise.
+StereoMode parseStereoMode(const std::string& text, const std::string& what = "--stereo");
 
 struct RenderOptions {
   uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
@@ -32,6 +35,7 @@ struct RenderOptions {
   DensityKernel kernel = DensityKernel::Hybrid;
   GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
   bool eyes[2] = {true, true};
+  StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading
   uint32_t photonCount() const { return photonsX * photonsY; }
   // The photon pass these options ask for (every backend traces the same photons).
   PhotonTraceParams photonTraceParams() const {
@@ -49,12 +53,18 @@ struct StageTimings {
   // Within an eye: eye rays (to the gather points) and density estimation; for the single
   // kernel everything is eye rays.
   double eyeRayMs[2] = {0, 0}, densityMs[2] = {0, 0};
+  // Scatter's projection of the left hit points into the right image (visibility rays and
+  // atomics), counted in the right eye's time.
+  double scatterMs = 0;
   double totalMs() const { return photonTraceMs + mapBuildMs + eyeMs[0] + eyeMs[1]; }
 };
 
 struct EyeResult {
   Image image;
   std::vector<uint32_t> firstPrim;  ///< per pixel, the triangle its centre ray hit first (~0u: none)
+  /// The right eye under stereo reuse: per pixel, the left pixel whose shading it took
+  /// (kNotReused: shaded here). Empty otherwise.
+  std::vector<uint32_t> reusedFrom;
 };
 
 struct FrameResult {
@@ -63,6 +73,7 @@ struct FrameResult {
   size_t storedPhotons = 0;
   size_t mapBytes = 0;
   size_t deviceBytes = 0;  ///< GPU memory held by the backend (0 on the CPU)
+  size_t reusedPixels = 0;  ///< right-eye pixels that took the left eye's shading
 };
 
 // Checks options against the rig; throws pvr::Error naming the bad value.

@@ -10,6 +10,7 @@
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/photon/density.h"
 #include "pvr/shading/scene_view.h"
+#include "pvr/stereo/stereo_reuse.h"
 #include "pvr/util/rng.h"
 
 namespace pvr {
@@ -24,9 +25,12 @@ struct GatherParams {
   uint32_t seed = 1;
 };
 
+// One pixel's result. Sample 0 (the centre ray) decides everything but the radiance.
 struct PixelSample {
   Vec3 radiance{0, 0, 0};
-  uint32_t firstPrim = ~0u;  ///< triangle seen first by the pixel's centre sample, ~0u for none
+  uint32_t firstPrim = ~0u;          ///< triangle seen first by the pixel's centre sample, ~0u for none
+  uint32_t reusedFrom = kNotReused;  ///< the other eye's pixel whose shading this pixel took
+  SurfaceRecord surface;             ///< what the other eye may reuse from this pixel
 };
 
 // Where an eye path meets its first diffuse surface, with everything gathered on the way except
@@ -41,17 +45,20 @@ struct GatherPoint {
   PVR_HOST_DEVICE bool needsEstimate() const { return !isBlack(weight); }
 };
 
-// Follows the eye ray through mirrors and glass to the first diffuse surface.
+// Follows the eye ray through mirrors and glass to the first diffuse surface. `firstHit`, if
+// given, is the ray's first intersection, already traced.
 template <class Intersector>
 PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Intersector& intersector,
-                                           const GatherParams& params, Ray ray, CounterRng& rng, uint32_t* firstPrim) {
+                                           const GatherParams& params, Ray ray, CounterRng& rng,
+                                           const Hit* firstHit = nullptr) {
   GatherPoint out;
   Vec3 throughput{1, 1, 1};
   float eps = scene.rayEpsilon();
   for (int depth = 0; depth <= params.maxSpecularDepth; ++depth) {
     Hit hit;
-    if (!intersector.intersect(ray, INFINITY, hit)) break;
-    if (depth == 0 && firstPrim) *firstPrim = hit.primId;
+    if (depth == 0 && firstHit) hit = *firstHit;
+    else intersector.intersect(ray, INFINITY, hit);
+    if (!hit.valid()) break;
     SurfacePoint sp = scene.surfacePoint(hit);
     const Material& m = scene.materials[sp.materialId];
     bool front = dot(ray.dir, sp.geometricNormal) < 0.0f;
@@ -93,10 +100,11 @@ PVR_HOST_DEVICE Vec3 finishGather(const PhotonMap& map, const GatherPoint& point
   return point.radiance + point.weight * estimateFluxDensity(map, point.position, point.normal, density);
 }
 
+// Radiance arriving along one eye ray.
 template <class Intersector, class PhotonMap>
 PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
-                                      const GatherParams& params, Ray ray, CounterRng& rng, uint32_t* firstPrim) {
-  return finishGather(map, traceToDiffuse(scene, intersector, params, ray, rng, firstPrim), params.density);
+                                      const GatherParams& params, Ray ray, CounterRng& rng) {
+  return finishGather(map, traceToDiffuse(scene, intersector, params, ray, rng), params.density);
 }
 
 // The camera ray of sample s of pixel (x, y), with the random numbers that continue its path. The
@@ -110,15 +118,55 @@ PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeC
   return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 
-// Radiance of pixel (x, y) of one eye: the average of samplesPerPixel jittered rays.
+// Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
+// `pixel`: the first hit, the surface record, and whether the pixel reuses the other eye's shading
+// (`reuse`); later samples read that decision from `pixel`. A reused pixel's gather point carries
+// the other eye's finished colour and needs no estimate. The random numbers of a pixel that is
+// not reused are those of separate rendering, so it comes out bit for bit the same.
+template <class Intersector>
+PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Intersector& intersector,
+                                             const GatherParams& params, const EyeCamera& camera, Eye eye, int x,
+                                             int y, int s, const StereoReuseView& reuse, PixelSample& pixel) {
+  GatherPoint reused;
+  if (s == 0 && reuse.mode == StereoMode::Scatter) {
+    pixel.reusedFrom = scatteredSource(reuse.scattered[size_t(y) * camera.width + x]);
+    if (pixel.reusedFrom != kNotReused) pixel.firstPrim = reuse.sourceSurfaces[pixel.reusedFrom].prim;
+  }
+  if (pixel.reusedFrom != kNotReused) {
+    reused.radiance = reuse.sourceImage[pixel.reusedFrom];
+    return reused;
+  }
+  CounterRng rng(0, 0, 0);
+  Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
+  if (s > 0) return traceToDiffuse(scene, intersector, params, ray, rng);
+  Hit first;
+  intersector.intersect(ray, INFINITY, first);
+  pixel.firstPrim = first.primId;
+  pixel.surface = surfaceRecordOf(scene, camera, ray, first);
+  if (reuse.mode == StereoMode::Gather) {
+    pixel.reusedFrom = gatherSource(reuse, pixel.surface);
+    if (pixel.reusedFrom != kNotReused) {
+      reused.radiance = reuse.sourceImage[pixel.reusedFrom];
+      return reused;
+    }
+  }
+  return traceToDiffuse(scene, intersector, params, ray, rng, &first);
+}
+
+// Pixel (x, y) of one eye: the average of samplesPerPixel jittered rays, or the other eye's
+// colour where `reuse` finds the same surface point.
 template <class Intersector, class PhotonMap>
 PVR_HOST_DEVICE PixelSample shadePixel(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
-                                       const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y) {
+                                       const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
+                                       const StereoReuseView& reuse = StereoReuseView()) {
   PixelSample out;
   for (int s = 0; s < params.samplesPerPixel; ++s) {
-    CounterRng rng(0, 0, 0);
-    Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
-    out.radiance += radianceAlongRay(scene, intersector, map, params, ray, rng, s == 0 ? &out.firstPrim : nullptr);
+    GatherPoint point = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, s, reuse, out);
+    if (out.reusedFrom != kNotReused) {  // the other eye's finished colour
+      out.radiance = point.radiance;
+      return out;
+    }
+    out.radiance += finishGather(map, point, params.density);
   }
   out.radiance *= 1.0f / float(params.samplesPerPixel);
   return out;
