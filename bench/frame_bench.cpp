@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "pvr/render/image_compare.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "bench_util.h"
@@ -113,7 +114,8 @@ ImageDiff compareImages(const Image& a, const Image& b) {
 
 struct CellResult {
   double frameMs = 0, traceMs = 0, buildMs = 0, raysMs = 0, densityMs = 0;
-  size_t stored = 0, deviceBytes = 0, mapBytes = 0;
+  double eyeMs[2] = {0, 0}, scatterMs = 0;
+  size_t stored = 0, deviceBytes = 0, mapBytes = 0, reusedPixels = 0;
   FrameResult last;  ///< a frame with images, for the checks
 };
 
@@ -128,12 +130,17 @@ CellResult timeCell(FrameRenderer& renderer, const StereoRig& rig, const RenderO
     r.buildMs += f.timings.mapBuildMs;
     r.raysMs += f.timings.eyeRayMs[0] + f.timings.eyeRayMs[1];
     r.densityMs += f.timings.densityMs[0] + f.timings.densityMs[1];
+    r.eyeMs[0] += f.timings.eyeMs[0];
+    r.eyeMs[1] += f.timings.eyeMs[1];
+    r.scatterMs += f.timings.scatterMs;
+    r.reusedPixels = f.reusedPixels;
     r.stored = f.storedPhotons;
     r.deviceBytes = std::max(r.deviceBytes, f.deviceBytes);
     r.mapBytes = f.mapBytes;
   }
   double n = std::max(frames, 1);
   r.frameMs /= n, r.traceMs /= n, r.buildMs /= n, r.raysMs /= n, r.densityMs /= n;
+  r.eyeMs[0] /= n, r.eyeMs[1] /= n, r.scatterMs /= n;
   r.last = renderer.render(rig, o, true);
   return r;
 }
@@ -219,6 +226,96 @@ int runTables(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& ren
   return failures;
 }
 
+// The paper's Table 5: both eyes shaded separately against the right eye reusing the left eye's
+// shading. Quality: the right eye with reuse against the right eye rendered separately from the
+// same photon map (photon tracing is deterministic), as displayed (sRGB).
+int runStereo(const FrameBenchArgs& args, FrameRenderer& renderer, nlohmann::json& json) {
+  std::vector<StereoMode> modes;
+  for (const std::string& m : splitList(args.stereo)) modes.push_back(parseStereoMode(m));
+  if (std::find(modes.begin(), modes.end(), StereoMode::Separate) == modes.end())
+    modes.insert(modes.begin(), StereoMode::Separate);  // the baseline the others are compared with
+  struct StereoRow {
+    uint32_t photons;
+    float radius;
+  };
+  const std::vector<StereoRow> paperRows = {{512, 0.05f}, {512, 0.1f}, {512, 0.2f},
+                                            {256, 0.05f}, {256, 0.1f}, {256, 0.2f}};
+  int failures = 0;
+  std::vector<std::string> scenes = splitList(args.stereoScenes);
+  for (size_t si = 0; si < scenes.size(); ++si) {
+    Scene scene = loadScene(scenes[si]);
+    StereoRig rig = benchRig(scene, args);
+    std::unique_ptr<FrameRenderer> sceneRenderer;  // the caller's renderer is for args.scene
+    FrameRenderer* r = &renderer;
+    if (scenes[si] != args.scene) {
+      sceneRenderer = makeFrameRenderer(renderer.name() == "cuda" ? BackendKind::Cuda : BackendKind::Cpu, scene);
+      r = sceneRenderer.get();
+    }
+    std::vector<StereoRow> rows = si == 0 ? paperRows : std::vector<StereoRow>{paperRows[0]};
+    std::printf("\nTable 5%s: separate eyes vs binocular reuse on %s (%s backend), scene %s, both eyes %dx%d, "
+                "IPD %.0f mm, hash grid, radius estimate, hybrid kernel, photon-map-only shading, %d frames after %d "
+                "warm-up.\nright/left = right eye's time (scatter included) over the left eye's; reused = share of "
+                "right-eye pixels that took the left eye's shading; PSNR and >1%% = right eye against its separate "
+                "rendering from the same photon map, displayed (sRGB).\n\n| photons | radius |",
+                si == 0 ? "" : " (other scenes)", r->deviceName().c_str(), r->name().c_str(), scene.name.c_str(),
+                rig.width, rig.height, rig.ipd * 1000.0f, args.frames, args.warmup);
+    for (StereoMode m : modes) std::printf(" %s ms |", stereoModeName(m));
+    std::printf("\n|---|---|");
+    for (size_t c = 0; c < modes.size(); ++c) std::printf("---|");
+    std::printf("\n");
+    std::string details;
+    for (const StereoRow& row : rows) {
+      std::vector<CellResult> cells;
+      for (StereoMode m : modes) {
+        RenderOptions o;
+        o.photonsX = o.photonsY = row.photons;
+        o.gather.mode = ShadingMode::PhotonMapOnly;
+        o.gather.density.radius = row.radius;
+        o.gather.density.estimator = Estimator::Radius;
+        o.kernel = DensityKernel::Hybrid;
+        o.stereo = m;
+        cells.push_back(timeCell(*r, rig, o, args.warmup, args.frames));
+      }
+      std::printf("| %ux%u | %g |", row.photons, row.photons, row.radius);
+      for (const CellResult& c : cells) std::printf(" %.2f |", c.frameMs);
+      std::printf("\n");
+      const FrameResult& reference = cells[0].last;
+      for (size_t c = 0; c < cells.size(); ++c) {
+        const CellResult& cell = cells[c];
+        ImageComparison q = compareDisplayed(cell.last.eyes[1].image, reference.eyes[1].image);
+        // Self-check: reuse leaves the left eye alone and does not wreck the right one.
+        bool leftSame = compareDisplayed(cell.last.eyes[0].image, reference.eyes[0].image).meanSquaredError == 0;
+        bool ok = leftSame && (c == 0 || q.psnr >= 30.0);
+        failures += ok ? 0 : 1;
+        double reuse = double(cell.last.reusedPixels) / (double(rig.width) * rig.height);
+        double ratio = cell.eyeMs[0] > 0 ? cell.eyeMs[1] / cell.eyeMs[0] : 0.0;
+        char psnr[32], line[512];
+        if (c == 0) std::snprintf(psnr, sizeof psnr, "ref");
+        else std::snprintf(psnr, sizeof psnr, "%.1f", q.psnr);  // prints inf for identical images
+        std::snprintf(line, sizeof line,
+                      "| %ux%u | %g | %s | %.2f | %.3f | %.3f | %.3f | %.2f | %.1f%% | %s | %.2f%% | %s |\n",
+                      row.photons, row.photons, row.radius, stereoModeName(modes[c]), cell.frameMs, cell.eyeMs[0],
+                      cell.eyeMs[1], cell.scatterMs, ratio, 100.0 * reuse, psnr, 100.0 * q.fractionOver1Percent,
+                      ok ? "ok" : "MISMATCH");
+        details += line;
+        json.push_back({{"table", 5}, {"scene", scene.name}, {"photons", row.photons * row.photons},
+                        {"photons_grid", row.photons}, {"radius", row.radius}, {"stereo", stereoModeName(modes[c])},
+                        {"width", rig.width}, {"height", rig.height}, {"ipd_m", rig.ipd}, {"frame_ms", cell.frameMs},
+                        {"left_eye_ms", cell.eyeMs[0]}, {"right_eye_ms", cell.eyeMs[1]},
+                        {"scatter_ms", cell.scatterMs}, {"right_left_ratio", ratio}, {"reused_fraction", reuse},
+                        {"psnr_db", c == 0 || std::isinf(q.psnr) ? nlohmann::json() : nlohmann::json(q.psnr)},
+                        {"over_1pct_fraction", q.fractionOver1Percent}, {"check", ok ? "ok" : "MISMATCH"}});
+      }
+      std::fflush(stdout);
+    }
+    std::printf("\nTable 5%s per eye (ms per frame):\n\n| photons | radius | stereo | frame | left eye | right eye | "
+                "of which scatter | right/left | reused | PSNR dB | >1%% | check |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|\n%s",
+                si == 0 ? "" : " (other scenes)", details.c_str());
+  }
+  return failures;
+}
+
 #ifdef PVR_HAVE_CUDA
 int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
   int failures = 0;
@@ -299,8 +396,9 @@ int runGrid(const FrameBenchArgs& args, nlohmann::json& json) {
 }  // namespace
 
 int runFrameBench(const FrameBenchArgs& args) {
-  if (args.suite != "tables" && args.suite != "rays" && args.suite != "grid" && args.suite != "all")
-    throw Error("--suite must be tables, rays, grid or all, got '" + args.suite + "'");
+  if (args.suite != "tables" && args.suite != "rays" && args.suite != "grid" && args.suite != "stereo" &&
+      args.suite != "all")
+    throw Error("--suite must be tables, rays, grid, stereo or all, got '" + args.suite + "'");
   if (args.frames < 1 || args.frames > 100000) throw Error("--frames must be between 1 and 100000");
   if (args.warmup < 0 || args.warmup > 100000) throw Error("--warmup must be between 0 and 100000");
   if (args.k < 1 || args.k > kMaxKnn) throw Error("--k must be between 1 and " + std::to_string(kMaxKnn));
@@ -312,11 +410,12 @@ int runFrameBench(const FrameBenchArgs& args) {
                 (kind == BackendKind::Cpu ? std::string("--backend cpu was given") : why));
   nlohmann::json json = nlohmann::json::array();
   int failures = 0;
-  if (args.suite == "tables" || args.suite == "all") {
+  if (args.suite == "tables" || args.suite == "stereo" || args.suite == "all") {
     Scene scene = loadScene(args.scene);
     StereoRig rig = benchRig(scene, args);
     std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
-    failures += runTables(args, scene, *renderer, rig, json);
+    if (args.suite != "stereo") failures += runTables(args, scene, *renderer, rig, json);
+    if (args.suite != "tables") failures += runStereo(args, *renderer, json);
   }
 #ifdef PVR_HAVE_CUDA
   if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json);

@@ -4,18 +4,22 @@
 //    hybrid kernel, with vs without shared memory), every cell a full stereo frame (photons
 //    traced, map built, both eyes shaded) averaged over many frames after warm-up;
 //  - rays: rays per second of the CUDA traversal (primary, shadow, diffuse);
-//  - grid: the hash-grid build of 1M photons on the GPU.
+//  - grid: the hash-grid build of 1M photons on the GPU;
+//  - stereo: the paper's empty Table 5, separate rendering against binocular reuse (scatter, the
+//    paper's; gather, ours), with the right eye's reuse fraction, cost and image quality.
 // Every suite checks its own results and says which GPU, resolution, photons and radius it ran.
 #include <string>
 
 namespace pvr {
 
 struct FrameBenchArgs {
-  std::string suite = "tables";  ///< tables | rays | grid | all
+  std::string suite = "tables";  ///< tables | rays | grid | stereo | all
   std::string scene = "cornell";
   std::string raysScene = "cornell,cornell-dense";
   std::string backend = "auto";
   std::string tables = "1,2,3,4";
+  std::string stereo = "separate,scatter,gather";  ///< Table 5's columns
+  std::string stereoScenes = "cornell,cornell-caustics";  ///< Table 5 on the first; the others: one row
   std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
   int frames = 100;
   int warmup = 10;

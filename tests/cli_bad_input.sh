@@ -40,6 +40,9 @@ expect_error "photons must be" render cornell --photons 0 --eye-size 8x8
 expect_error "--backend must be" render cornell --backend gpu --eye-size 8x8
 expect_error "--kernel must be" render cornell --kernel fused --eye-size 8x8
 expect_error "works on the hash grid" render cornell --kernel shared --map kdtree --eye-size 8x8
+expect_error "--stereo must be" render cornell --stereo both --eye-size 8x8
+expect_error "needs both eyes" render cornell --stereo gather --eyes left --eye-size 8x8
+expect_error "--stereo must be" bench --suite stereo --backend cpu --stereo mirror --eye-size 8x8 --frames 1
 expect_error "--suite must be" bench --suite speed
 expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1

@@ -133,6 +133,51 @@ TEST(GpuBackend, ImagesMatchTheCpuForEveryScheme) {
   }
 }
 
+// Stereo reuse on the GPU makes the same decisions as on the CPU (the same shared code): the
+// reuse sources agree pixel for pixel (up to float rounding at edges), the images agree, and the
+// right eye with reuse is as close to its separate rendering as on the CPU. Every kernel scheme.
+TEST(GpuBackend, StereoReuseMatchesTheCpu) {
+  PVR_REQUIRE_GPU();
+  for (const char* name : {"cornell", "cornell-caustics"}) {
+    Scene scene = builtinScene(name);
+    StereoRig rig = scene.rig;
+    rig.width = 160, rig.height = 176;
+    CpuFrameRenderer cpu(scene);
+    CudaFrameRenderer gpu(scene);
+    for (StereoMode stereo : {StereoMode::Scatter, StereoMode::Gather})
+      for (int spp : {1, 2}) {
+        RenderOptions o;
+        o.photonsX = o.photonsY = 128;
+        o.gather.density.radius = 0.08f;
+        o.gather.samplesPerPixel = spp;
+        o.stereo = stereo;
+        FrameResult reference = cpu.render(rig, o);
+        for (DensityKernel kernel : {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory,
+                                     DensityKernel::CellSorted}) {
+          o.kernel = kernel;
+          FrameResult frame = gpu.render(rig, o);
+          std::string what = std::string(name) + " " + stereoModeName(stereo) + " " + densityKernelName(kernel) +
+                             " spp " + std::to_string(spp);
+          ImageCheck c = compare(reference, frame);
+          EXPECT_LT(c.relativeMad, 0.01) << what;
+          EXPECT_LT(c.outliers, 0.005) << what;
+          const auto &a = reference.eyes[1].reusedFrom, &b = frame.eyes[1].reusedFrom;
+          ASSERT_EQ(a.size(), b.size()) << what;
+          size_t same = 0, reused = 0;
+          for (size_t i = 0; i < a.size(); ++i) {
+            same += a[i] == b[i] ? 1 : 0;
+            reused += b[i] != kNotReused ? 1 : 0;
+          }
+          EXPECT_GE(double(same), 0.995 * double(a.size())) << what;
+          EXPECT_EQ(reused, frame.reusedPixels) << what << ": the warp-aggregated count";
+          EXPECT_GT(reused, a.size() / 3) << what;
+          double cpuReuse = double(reference.reusedPixels), gpuReuse = double(frame.reusedPixels);
+          EXPECT_NEAR(gpuReuse, cpuReuse, 0.005 * double(a.size())) << what;
+        }
+      }
+  }
+}
+
 TEST(GpuBackend, RayTraversalAgreesWithEmbree) {
   PVR_REQUIRE_GPU();
   for (const char* name : {"cornell", "cornell-caustics"}) {

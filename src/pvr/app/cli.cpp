@@ -225,9 +225,16 @@ int runCli(int argc, char** argv) {
   FrameBenchArgs fa;
   CLI::App* bench = app.add_subcommand(
       "bench", "Benchmarks that check their own results: the paper's Tables 1-4 as whole stereo frames (tables), "
+               "Table 5, binocular reuse (stereo), "
                "CUDA ray throughput (rays), GPU hash-grid build (grid), CPU photon-map queries (maps)");
   bench->add_option("scene", ba.scene, "Scene for the tables, grid and maps suites")->capture_default_str();
-  bench->add_option("--suite", fa.suite, "tables | rays | grid | all (tables, rays, grid) | maps (CPU map queries)")
+  bench->add_option("--suite", fa.suite,
+                    "tables | rays | grid | stereo | all (tables, stereo, rays, grid) | maps (CPU map queries)")
+      ->capture_default_str();
+  bench->add_option("--stereo", fa.stereo, "Table 5's columns: separate, scatter, gather (stereo suite)")
+      ->capture_default_str();
+  bench->add_option("--stereo-scenes", fa.stereoScenes,
+                    "Scenes of the stereo suite: Table 5 on the first, one row on each other")
       ->capture_default_str();
   bench->add_option("--backend", fa.backend, "Backend of the tables suite: cpu | cuda | auto")->capture_default_str();
   bench->add_option("--tables", fa.tables, "Paper tables to run (tables suite)")->capture_default_str();
