@@ -15,8 +15,11 @@
 //    one right pixel the nearest wins (distance and left pixel index in one 64-bit atomic
 //    minimum). Right pixels that received nothing are shaded.
 //  - Gather (ours): every right pixel traces its primary ray; its hit point, projected into the
-//    left image, reuses that left pixel if the left pixel's own hit is the same surface point
-//    (same triangle and side, within the pixel's footprint). No holes, no visibility rays.
+//    left image, reuses that left pixel if the left pixel's own hit is the same surface point:
+//    the same triangle, or a neighbouring one of the same material and orientation (a
+//    tessellated surface: with triangles of a pixel or less, the same-triangle test alone would
+//    reuse little), seen from the same side, within the pixel's footprint along the surface and
+//    a tenth of it off the surface. No holes, no visibility rays.
 #include <cstring>
 
 #include "pvr/camera/stereo_rig.h"
@@ -37,6 +40,7 @@ struct SurfaceRecord {
   uint32_t prim = ~0u;
   Vec3 normal{0, 0, 0};  ///< geometric normal, facing the eye
   float footprint = 0;   ///< size of the pixel on the surface at this point: the same-point tolerance
+  uint32_t material = 0;
   PVR_HOST_DEVICE bool reusable() const { return prim != ~0u; }
 };
 
@@ -63,6 +67,7 @@ PVR_HOST_DEVICE inline SurfaceRecord surfaceRecordOf(const SceneView& scene, con
   record.normal = dot(ray.dir, sp.geometricNormal) < 0.0f ? sp.geometricNormal : -sp.geometricNormal;
   record.footprint = pixelFootprint(camera, sp.position, record.normal);
   record.prim = hit.primId;
+  record.material = scene.materialIds[hit.primId];
   return record;
 }
 
@@ -127,9 +132,13 @@ PVR_HOST_DEVICE inline uint32_t gatherSource(const StereoReuseView& reuse, const
   if (!source.project(here.position, px, py) || !source.containsPixel(px, py)) return kNotReused;
   uint32_t pixel = uint32_t(py) * uint32_t(source.width) + uint32_t(px);
   const SurfaceRecord& there = reuse.sourceSurfaces[pixel];
-  if (there.prim != here.prim || dot(there.normal, here.normal) < kSameSurfaceCosine) return kNotReused;
+  // The same triangle, or another of the same material: position and orientation decide.
+  if (!there.reusable() || there.material != here.material || dot(there.normal, here.normal) < kSameSurfaceCosine)
+    return kNotReused;
   float tolerance = fmaxf(there.footprint, here.footprint);
-  if (lengthSquared(there.position - here.position) > tolerance * tolerance) return kNotReused;
+  Vec3 offset = there.position - here.position;
+  if (lengthSquared(offset) > tolerance * tolerance || fabsf(dot(offset, here.normal)) > 0.1f * tolerance)
+    return kNotReused;
   return pixel;
 }
 
