@@ -187,6 +187,15 @@ int runRender(const RenderArgs& a) {
       std::printf("wrote %s\n", path.c_str());
     }
   }
+  if (options.stereo != StereoMode::Separate) {  // where the right eye took the left eye's shading
+    const EyeResult& right = frame.eyes[1];
+    Image mask(right.image.width, right.image.height);
+    for (size_t i = 0; i < mask.pixels.size(); ++i)
+      mask.pixels[i] = right.reusedFrom[i] != kNotReused ? Vec3(1.0f) : (right.firstPrim[i] != ~0u ? Vec3(0.15f, 0, 0) : Vec3(0.0f));
+    std::string path = a.out + "_right_reused.png";
+    writeImage(mask, path, 1.0f);
+    std::printf("wrote %s (white: reused from the left eye; red: shaded by the right eye; black: background)\n", path.c_str());
+  }
   return 0;
 }
 

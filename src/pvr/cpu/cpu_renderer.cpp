@@ -57,6 +57,7 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
     samples[e].resize(size_t(camera.width) * camera.height);
     EyeResult& out = frame.eyes[e];
     StereoReuseView reuse;
+    reuse.recordSurfaces = e == 0 && options.stereo != StereoMode::Separate;
     std::vector<SurfaceRecord> sourceSurfaces;
     if (e == 1 && options.stereo != StereoMode::Separate) {
       reuse.mode = options.stereo;

@@ -1,4 +1,6 @@
 #include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_select.cuh>
+#include <thrust/iterator/counting_iterator.h>
 
 #include <algorithm>
 #include <vector>
@@ -170,6 +172,51 @@ __global__ void sortedDensityKernel(HashGridView map, DensityParams density, con
   storeSample(image, pixel, finishGather(map, points[pixel], density), sample, samples);
 }
 
+// Under stereo reuse the right eye is left with a sparse set of gather points (disocclusions,
+// edges, whatever is seen through mirrors and glass). One thread per point would leave the GPU
+// waiting on a few long chains of dependent loads; instead the points are listed (CUB select) and
+// each warp estimates one point, its lanes splitting every cell row's photons (radius estimate).
+struct NeedsEstimate {
+  const GatherPoint* points;
+  __device__ bool operator()(uint32_t pixel) const { return points[pixel].needsEstimate(); }
+};
+
+__global__ void storeWithoutEstimateKernel(const GatherPoint* points, uint32_t n, int sample, int samples, Vec3* image) {
+  uint32_t pixel = blockIdx.x * blockDim.x + threadIdx.x;
+  if (pixel >= n) return;
+  GatherPoint gp = points[pixel];
+  if (!gp.needsEstimate()) storeSample(image, pixel, gp.radiance, sample, samples);
+}
+
+__global__ void warpPerPointDensityKernel(HashGridView map, float radius, const GatherPoint* points,
+                                          const uint32_t* list, const uint32_t* listed, int sample, int samples,
+                                          Vec3* image) {
+  const unsigned lane = threadIdx.x & 31u;
+  const uint32_t warps = (gridDim.x * blockDim.x) >> 5;
+  const float r2 = radius * radius;
+  const uint32_t n = *listed;
+  for (uint32_t i = (blockIdx.x * blockDim.x + threadIdx.x) >> 5; i < n; i += warps) {  // warp-uniform
+    uint32_t pixel = list[i];
+    GatherPoint gp = points[pixel];
+    Vec3 sum{0, 0, 0};
+    int64_t cell = map.photonCount ? map.cellOf(gp.position) : -1;
+    for (int row = 0; cell >= 0 && row < 9; ++row) {
+      uint32_t first = uint32_t(cell + map.rowOffsets[row]);
+      uint32_t end = map.cellStart[first + 3];
+      for (uint32_t j = map.cellStart[first] + lane; j < end; j += 32) {
+        if (photonDistance2(gp.position, map.position(j)) <= r2 && photonFacesSurface(map.photons[j].direction, gp.normal))
+          sum += map.photons[j].power;
+      }
+    }
+    for (int offset = 16; offset > 0; offset >>= 1) {
+      sum.x += __shfl_xor_sync(0xffffffffu, sum.x, offset);
+      sum.y += __shfl_xor_sync(0xffffffffu, sum.y, offset);
+      sum.z += __shfl_xor_sync(0xffffffffu, sum.z, offset);
+    }
+    if (lane == 0) storeSample(image, pixel, gp.radiance + gp.weight * (sum * (1.0f / (kPi * r2))), sample, samples);
+  }
+}
+
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
 __global__ void primaryRaysKernel(BvhIntersector intersector, EyeCamera camera, Hit* hits) {
   int x, y;
@@ -251,7 +298,7 @@ void dispatchSingle(const DeviceScene& scene, DeviceMap map, const GatherParams&
 
 size_t GpuGather::memoryBytes() const {
   size_t bytes = points_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
-                 reusedCount_.bytes();
+                 reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes();
   for (int i = 0; i < 2; ++i)
     bytes += images_[i].bytes() + firstPrim_[i].bytes() + sortKeys_[i].bytes() + sortValues_[i].bytes();
   return bytes;
@@ -285,6 +332,7 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
   if (options.stereo != StereoMode::Separate && eye == Eye::Left) {
     surfaces_.reserve(pixels, "left-eye surfaces");
     out.surfaces = surfaces_.data();
+    reuse.recordSurfaces = true;
   } else if (options.stereo != StereoMode::Separate) {
     reuse.mode = options.stereo;
     reuse.source = rig.eye(Eye::Left);
@@ -310,7 +358,8 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
   }
 
   points_.reserve(pixels, "gather points");
-  const bool sorted = options.kernel == DensityKernel::CellSorted;
+  const bool sparse = reuse.reusing() && map.grid && !knn;  // the right eye under stereo reuse
+  const bool sorted = options.kernel == DensityKernel::CellSorted && !sparse;
   uint32_t noCell = 0;
   int endBit = 1;
   if (sorted) {
@@ -325,6 +374,14 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
     PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, k, v, int(pixels), 0, endBit, stream));
     temp_.reserve(bytes, "gather-point sort scratch");
   }
+  if (sparse) {
+    estimateList_.reserve(pixels, "gather points to estimate");
+    estimateCount_.reserve(1, "gather points to estimate");
+    size_t bytes = 0;
+    PVR_CUDA_CHECK(cub::DeviceSelect::If(nullptr, bytes, thrust::counting_iterator<uint32_t>(0), estimateList_.data(),
+                                         estimateCount_.data(), int(pixels), NeedsEstimate{points_.data()}, stream));
+    temp_.reserve(bytes, "gather-point selection scratch");
+  }
   timers.prepare(params.samplesPerPixel);
   for (int s = 0; s < params.samplesPerPixel; ++s) {
     timers.rays[s]->start(stream);
@@ -333,7 +390,22 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
     PVR_CUDA_CHECK_LAUNCH("eyeRays");
     timers.rays[s]->stop(stream);
     timers.density[s]->start(stream);
-    if (options.kernel == DensityKernel::Hybrid) {
+    if (sparse) {
+      size_t bytes = temp_.capacity();
+      PVR_CUDA_CHECK(cub::DeviceSelect::If(temp_.data(), bytes, thrust::counting_iterator<uint32_t>(0),
+                                           estimateList_.data(), estimateCount_.data(), int(pixels),
+                                           NeedsEstimate{points_.data()}, stream));
+      storeWithoutEstimateKernel<<<blocksFor(pixels, 256), 256, 0, stream>>>(points_.data(), uint32_t(pixels), s,
+                                                                            params.samplesPerPixel, image);
+      PVR_CUDA_CHECK_LAUNCH("storeWithoutEstimate");
+      int device = 0, sms = 0;
+      PVR_CUDA_CHECK(cudaGetDevice(&device));
+      PVR_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
+      warpPerPointDensityKernel<<<unsigned(sms) * 8u, 256, 0, stream>>>(*map.grid, params.density.radius, points_.data(),
+                                                                         estimateList_.data(), estimateCount_.data(), s,
+                                                                         params.samplesPerPixel, image);
+      PVR_CUDA_CHECK_LAUNCH("warpPerPointDensity");
+    } else if (options.kernel == DensityKernel::Hybrid) {
       if (map.grid) {
         if (knn) launchDensity<Estimator::Knn>(*map.grid, params.density, points_.data(), camera, s, params.samplesPerPixel, image, stream);
         else launchDensity<Estimator::Radius>(*map.grid, params.density, points_.data(), camera, s, params.samplesPerPixel, image, stream);

@@ -71,6 +71,7 @@ class GpuGather {
   DeviceBuffer<uint64_t> scattered_;
   DeviceBuffer<uint32_t> reusedFrom_;
   DeviceBuffer<unsigned> reusedCount_;
+  DeviceBuffer<uint32_t> estimateList_, estimateCount_;  ///< the right eye's points still to estimate
   DeviceBuffer<GatherPoint> points_;
   DeviceBuffer<uint32_t> sortKeys_[2], sortValues_[2];
   DeviceBuffer<unsigned char> temp_;

@@ -119,7 +119,7 @@ PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeC
 }
 
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
-// `pixel`: the first hit, the surface record, and whether the pixel reuses the other eye's shading
+// `pixel`: the first hit, the surface record (when `reuse` asks for it), and whether the pixel reuses the other eye's shading
 // (`reuse`); later samples read that decision from `pixel`. A reused pixel's gather point carries
 // the other eye's finished colour and needs no estimate. The random numbers of a pixel that is
 // not reused are those of separate rendering, so it comes out bit for bit the same.
@@ -142,7 +142,7 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   Hit first;
   intersector.intersect(ray, INFINITY, first);
   pixel.firstPrim = first.primId;
-  pixel.surface = surfaceRecordOf(scene, camera, ray, first);
+  if (reuse.recordSurfaces || reuse.mode == StereoMode::Gather) pixel.surface = surfaceRecordOf(scene, camera, ray, first);
   if (reuse.mode == StereoMode::Gather) {
     pixel.reusedFrom = gatherSource(reuse, pixel.surface);
     if (pixel.reusedFrom != kNotReused) {
