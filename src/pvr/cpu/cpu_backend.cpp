@@ -29,29 +29,31 @@ std::vector<Photon> CpuBackend::tracePhotons(const PhotonTraceParams& params) co
 
 template <class Map>
 void CpuBackend::renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                               PixelSample* out, const StereoReuseView& reuse) const {
+                               PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const {
   SceneView view = scene_.view();
   // 16x16 tiles: coherent rays per task and good load balance.
   tbb::parallel_for(tbb::blocked_range2d<int>(0, camera.height, 16, 0, camera.width, 16),
                     [&](const tbb::blocked_range2d<int>& r) {
                       for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-                        for (int x = r.cols().begin(); x < r.cols().end(); ++x)
-                          out[size_t(y) * camera.width + x] =
-                              shadePixel(view, intersector_, map, params, camera, eye, x, y, reuse);
+                        for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                          size_t pixel = size_t(y) * camera.width + x;
+                          out[pixel] = shadePixel(view, intersector_, map, params, camera, eye, x, y, reuse,
+                                                  surfaces ? surfaces + pixel : nullptr);
+                        }
                     });
 }
 
 void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
-                           PixelSample* out, const StereoReuseView& reuse) const {
-  renderEyeWith(camera, eye, params, map, out, reuse);
+                           PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const {
+  renderEyeWith(camera, eye, params, map, out, reuse, surfaces);
 }
 
 void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                           PixelSample* out, const StereoReuseView& reuse) const {
-  renderEyeWith(camera, eye, params, map, out, reuse);
+                           PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const {
+  renderEyeWith(camera, eye, params, map, out, reuse, surfaces);
 }
 
-size_t CpuBackend::scatter(const PixelSample* source, size_t sourcePixels, const EyeCamera& target,
+size_t CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target,
                            uint64_t* scattered) const {
   SceneView view = scene_.view();
   std::fill(scattered, scattered + size_t(target.width) * target.height, kNothingScattered);
@@ -61,7 +63,7 @@ size_t CpuBackend::scatter(const PixelSample* source, size_t sourcePixels, const
     for (size_t i = r.begin(); i < r.end(); ++i) {
       uint32_t pixel;
       uint64_t entry;
-      if (!scatterTarget(view, intersector_, source[i].surface, uint32_t(i), target, pixel, entry)) continue;
+      if (!scatterTarget(view, intersector_, source[i], uint32_t(i), target, pixel, entry)) continue;
       std::atomic_ref<uint64_t> slot(scattered[pixel]);  // keep the nearest: an atomic minimum
       uint64_t current = slot.load(std::memory_order_relaxed);
       while (entry < current && !slot.compare_exchange_weak(current, entry, std::memory_order_relaxed)) {

@@ -19,16 +19,19 @@ class CpuBackend {
   std::vector<Photon> tracePhotons(const PhotonTraceParams& params) const;
 
   // Shades every pixel of one eye into `out` (width * height entries, row-major, top row first),
-  // taking the other eye's shading where `reuse` allows.
+  // taking the other eye's shading where `reuse` allows, and recording each pixel's surface in
+  // `surfaces` if given (the eye the other one reuses).
   void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
-                 PixelSample* out, const StereoReuseView& reuse = StereoReuseView()) const;
+                 PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
+                 SurfaceRecord* surfaces = nullptr) const;
   void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                 PixelSample* out, const StereoReuseView& reuse = StereoReuseView()) const;
+                 PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
+                 SurfaceRecord* surfaces = nullptr) const;
 
   // Scatter: projects every reusable source pixel's surface into `target`'s image, keeping the
   // nearest per target pixel in `scattered` (width * height entries, filled with kNothingScattered
   // here). Returns the number of source points written.
-  size_t scatter(const PixelSample* source, size_t sourcePixels, const EyeCamera& target, uint64_t* scattered) const;
+  size_t scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target, uint64_t* scattered) const;
 
   const Scene& scene() const { return scene_; }
   const EmbreeIntersector& intersector() const { return intersector_; }
@@ -36,7 +39,7 @@ class CpuBackend {
  private:
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                     PixelSample* out, const StereoReuseView& reuse) const;
+                     PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const;
   const Scene& scene_;
   EmbreeIntersector intersector_;
 };

@@ -49,48 +49,48 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
   frame.timings.mapBuildMs = msSince(start);
 
   // The left eye first: under stereo reuse the right eye reads its surfaces and finished image.
-  std::vector<PixelSample> samples[2];
+  const bool reusing = options.stereo != StereoMode::Separate;
+  std::vector<PixelSample> samples;
+  std::vector<SurfaceRecord> leftSurfaces;
   std::vector<uint64_t> scattered;
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;
     EyeCamera camera = rig.eye(Eye(e));
-    samples[e].resize(size_t(camera.width) * camera.height);
+    samples.assign(size_t(camera.width) * camera.height, PixelSample());
     EyeResult& out = frame.eyes[e];
     StereoReuseView reuse;
-    reuse.recordSurfaces = e == 0 && options.stereo != StereoMode::Separate;
-    std::vector<SurfaceRecord> sourceSurfaces;
-    if (e == 1 && options.stereo != StereoMode::Separate) {
+    if (reusing && e == 0) leftSurfaces.resize(samples.size());
+    if (reusing && e == 1) {
       reuse.mode = options.stereo;
       reuse.source = rig.eye(Eye::Left);
-      sourceSurfaces.resize(samples[0].size());  // the layout the shared code reads (untimed copy)
-      for (size_t i = 0; i < samples[0].size(); ++i) sourceSurfaces[i] = samples[0][i].surface;
-      reuse.sourceSurfaces = sourceSurfaces.data();
+      reuse.sourceSurfaces = leftSurfaces.data();
       reuse.sourceImage = frame.eyes[0].image.pixels.data();
     }
+    SurfaceRecord* surfaces = reusing && e == 0 ? leftSurfaces.data() : nullptr;
     start = std::chrono::steady_clock::now();
     if (reuse.mode == StereoMode::Scatter) {
-      scattered.resize(samples[1].size());
-      backend.scatter(samples[0].data(), samples[0].size(), camera, scattered.data());
+      scattered.resize(samples.size());
+      backend.scatter(leftSurfaces.data(), leftSurfaces.size(), camera, scattered.data());
       reuse.scattered = scattered.data();
       frame.timings.scatterMs = msSince(start);
     }
     auto eyeStart = std::chrono::steady_clock::now();
     if (options.map == PhotonMapKind::HashGrid)
-      backend.renderEye(camera, Eye(e), options.gather, grid.view(), samples[e].data(), reuse);
+      backend.renderEye(camera, Eye(e), options.gather, grid.view(), samples.data(), reuse, surfaces);
     else
-      backend.renderEye(camera, Eye(e), options.gather, tree.view(), samples[e].data(), reuse);
+      backend.renderEye(camera, Eye(e), options.gather, tree.view(), samples.data(), reuse, surfaces);
     frame.timings.eyeRayMs[e] = msSince(eyeStart);  // one fused pass, like the single kernel
     frame.timings.eyeMs[e] = msSince(start);
     out.image = Image(camera.width, camera.height);
-    out.firstPrim.resize(samples[e].size());
-    for (size_t i = 0; i < samples[e].size(); ++i) {
-      out.image.pixels[i] = samples[e][i].radiance;
-      out.firstPrim[i] = samples[e][i].firstPrim;
+    out.firstPrim.resize(samples.size());
+    for (size_t i = 0; i < samples.size(); ++i) {
+      out.image.pixels[i] = samples[i].radiance;
+      out.firstPrim[i] = samples[i].firstPrim;
     }
     if (reuse.reusing()) {
-      out.reusedFrom.resize(samples[e].size());
-      for (size_t i = 0; i < samples[e].size(); ++i) {
-        out.reusedFrom[i] = samples[e][i].reusedFrom;
+      out.reusedFrom.resize(samples.size());
+      for (size_t i = 0; i < samples.size(); ++i) {
+        out.reusedFrom[i] = samples[i].reusedFrom;
         frame.reusedPixels += out.reusedFrom[i] != kNotReused ? 1 : 0;
       }
     }

@@ -27,11 +27,10 @@ __device__ inline void storeSample(Vec3* image, size_t pixel, Vec3 c, int sample
   image[pixel] = v;
 }
 
-// Everything of a pixel but its radiance: first-hit id, the surface the right eye may reuse, and
-// the reuse decision (counted per warp: one atomic per warp, not per pixel).
+// Everything of a pixel but its radiance and surface: first-hit id and the reuse decision (counted
+// per warp: one atomic per warp, not per pixel).
 __device__ inline void recordPixel(const EyeOutputs& out, size_t pixel, const PixelSample& p) {
   out.firstPrim[pixel] = p.firstPrim;
-  if (out.surfaces) out.surfaces[pixel] = p.surface;
   if (!out.reusedFrom) return;
   out.reusedFrom[pixel] = p.reusedFrom;
   unsigned active = __activemask();
@@ -40,28 +39,51 @@ __device__ inline void recordPixel(const EyeOutputs& out, size_t pixel, const Pi
   if (lane == unsigned(__ffs(int(active)) - 1) && reused) atomicAdd(out.reusedCount, unsigned(__popc(int(reused))));
 }
 
+// An eye's part in stereo reuse, a compile-time kernel parameter: the reuse code paths cost
+// registers, so an eye that does not reuse gets kernels without them.
+enum class StereoRole : int {
+  Alone = 0,   ///< separate rendering
+  Source = 1,  ///< the left eye under reuse: records its surfaces
+  Reuser = 2,  ///< the right eye under reuse
+};
+
+template <StereoRole R>
+__device__ inline StereoReuseView reuseFor(const StereoReuseView& reuse) {
+  if constexpr (R == StereoRole::Reuser) return reuse;
+  else return StereoReuseView();
+}
+
+template <StereoRole R>
+__device__ inline SurfaceRecord* surfaceFor(const EyeOutputs& out, size_t pixel) {
+  if constexpr (R == StereoRole::Source) return out.surfaces + pixel;
+  else return nullptr;
+}
+
 // The paper's "single" scheme: eye ray and estimate in one kernel.
-template <class Map, Estimator E>
+template <class Map, Estimator E, StereoRole R>
 __global__ void singleKernel(SceneView scene, BvhIntersector intersector, Map map, GatherParams params,
                              EyeCamera camera, Eye eye, StereoReuseView reuse, EyeOutputs out) {
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   params.density.estimator = E;  // compile-time estimator: the radius kernel carries no heap
-  PixelSample s = shadePixel(scene, intersector, map, params, camera, eye, x, y, reuse);
   size_t pixel = size_t(y) * camera.width + x;
+  PixelSample s = shadePixel(scene, intersector, map, params, camera, eye, x, y, reuseFor<R>(reuse),
+                             surfaceFor<R>(out, pixel));
   out.image[pixel] = s.radiance;
   recordPixel(out, pixel, s);
 }
 
 // Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
+template <StereoRole R>
 __global__ void eyeRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
                               Eye eye, int sample, StereoReuseView reuse, GatherPoint* points, EyeOutputs out) {
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   size_t pixel = size_t(y) * camera.width + x;
   PixelSample state;
-  if (sample > 0 && out.reusedFrom) state.reusedFrom = out.reusedFrom[pixel];  // sample 0 decided
-  points[pixel] = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuse, state);
+  if (R == StereoRole::Reuser && sample > 0) state.reusedFrom = out.reusedFrom[pixel];  // sample 0 decided
+  points[pixel] = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuseFor<R>(reuse), state,
+                                   surfaceFor<R>(out, pixel));
   if (sample == 0) recordPixel(out, pixel, state);
 }
 
@@ -274,8 +296,11 @@ __global__ void diffuseRaysKernel(SceneView scene, BvhIntersector intersector, E
 template <Estimator E, class Map>
 void launchSingle(const DeviceScene& scene, const Map& map, const GatherParams& params, const EyeCamera& camera,
                   Eye eye, const StereoReuseView& reuse, const EyeOutputs& out, cudaStream_t stream) {
-  singleKernel<Map, E><<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
-      scene.view, scene.intersector, map, params, camera, eye, reuse, out);
+  auto* kernel = out.reusedFrom ? singleKernel<Map, E, StereoRole::Reuser>
+                 : out.surfaces ? singleKernel<Map, E, StereoRole::Source>
+                                : singleKernel<Map, E, StereoRole::Alone>;
+  kernel<<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(scene.view, scene.intersector, map,
+                                                                                   params, camera, eye, reuse, out);
   PVR_CUDA_CHECK_LAUNCH("single");
 }
 
@@ -332,7 +357,6 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
   if (options.stereo != StereoMode::Separate && eye == Eye::Left) {
     surfaces_.reserve(pixels, "left-eye surfaces");
     out.surfaces = surfaces_.data();
-    reuse.recordSurfaces = true;
   } else if (options.stereo != StereoMode::Separate) {
     reuse.mode = options.stereo;
     reuse.source = rig.eye(Eye::Left);
@@ -385,7 +409,10 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
   timers.prepare(params.samplesPerPixel);
   for (int s = 0; s < params.samplesPerPixel; ++s) {
     timers.rays[s]->start(stream);
-    eyeRaysKernel<<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
+    auto* eyeRays = out.reusedFrom ? eyeRaysKernel<StereoRole::Reuser>
+                    : out.surfaces ? eyeRaysKernel<StereoRole::Source>
+                                   : eyeRaysKernel<StereoRole::Alone>;
+    eyeRays<<<tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream>>>(
         scene.view, scene.intersector, params, camera, eye, s, reuse, points_.data(), out);
     PVR_CUDA_CHECK_LAUNCH("eyeRays");
     timers.rays[s]->stop(stream);

@@ -30,7 +30,6 @@ struct PixelSample {
   Vec3 radiance{0, 0, 0};
   uint32_t firstPrim = ~0u;          ///< triangle seen first by the pixel's centre sample, ~0u for none
   uint32_t reusedFrom = kNotReused;  ///< the other eye's pixel whose shading this pixel took
-  SurfaceRecord surface;             ///< what the other eye may reuse from this pixel
 };
 
 // Where an eye path meets its first diffuse surface, with everything gathered on the way except
@@ -119,14 +118,17 @@ PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeC
 }
 
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
-// `pixel`: the first hit, the surface record (when `reuse` asks for it), and whether the pixel reuses the other eye's shading
-// (`reuse`); later samples read that decision from `pixel`. A reused pixel's gather point carries
+// `pixel` (the first hit, and whether the pixel reuses the other eye's shading
+// (`reuse`)) and writes the pixel's surface record to `surfaceOut` if given (the left eye under
+// reuse: written at once, so that it is not kept live through the density estimate); later
+// samples read the decision from `pixel`. A reused pixel's gather point carries
 // the other eye's finished colour and needs no estimate. The random numbers of a pixel that is
 // not reused are those of separate rendering, so it comes out bit for bit the same.
 template <class Intersector>
 PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Intersector& intersector,
                                              const GatherParams& params, const EyeCamera& camera, Eye eye, int x,
-                                             int y, int s, const StereoReuseView& reuse, PixelSample& pixel) {
+                                             int y, int s, const StereoReuseView& reuse, PixelSample& pixel,
+                                             SurfaceRecord* surfaceOut = nullptr) {
   GatherPoint reused;
   if (s == 0 && reuse.mode == StereoMode::Scatter) {
     pixel.reusedFrom = scatteredSource(reuse.scattered[size_t(y) * camera.width + x]);
@@ -142,9 +144,9 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   Hit first;
   intersector.intersect(ray, INFINITY, first);
   pixel.firstPrim = first.primId;
-  if (reuse.recordSurfaces || reuse.mode == StereoMode::Gather) pixel.surface = surfaceRecordOf(scene, camera, ray, first);
+  if (surfaceOut) *surfaceOut = surfaceRecordOf(scene, camera, ray, first);
   if (reuse.mode == StereoMode::Gather) {
-    pixel.reusedFrom = gatherSource(reuse, pixel.surface);
+    pixel.reusedFrom = gatherSource(reuse, surfaceRecordOf(scene, camera, ray, first));
     if (pixel.reusedFrom != kNotReused) {
       reused.radiance = reuse.sourceImage[pixel.reusedFrom];
       return reused;
@@ -158,10 +160,12 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
 template <class Intersector, class PhotonMap>
 PVR_HOST_DEVICE PixelSample shadePixel(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
                                        const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
-                                       const StereoReuseView& reuse = StereoReuseView()) {
+                                       const StereoReuseView& reuse = StereoReuseView(),
+                                       SurfaceRecord* surfaceOut = nullptr) {
   PixelSample out;
   for (int s = 0; s < params.samplesPerPixel; ++s) {
-    GatherPoint point = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, s, reuse, out);
+    GatherPoint point = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, s, reuse, out,
+                                         s == 0 ? surfaceOut : nullptr);
     if (out.reusedFrom != kNotReused) {  // the other eye's finished colour
       out.radiance = point.radiance;
       return out;

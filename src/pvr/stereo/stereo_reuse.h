@@ -78,7 +78,6 @@ struct StereoReuseView {
   const SurfaceRecord* sourceSurfaces = nullptr;  ///< per source pixel
   const Vec3* sourceImage = nullptr;              ///< the source eye's finished image
   const uint64_t* scattered = nullptr;            ///< Scatter: per pixel of this eye, packScatter() or kNothingScattered
-  bool recordSurfaces = false;                    ///< the source eye itself: record what the other eye may reuse
 
   PVR_HOST_DEVICE bool reusing() const { return mode != StereoMode::Separate; }
 };
