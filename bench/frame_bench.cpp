@@ -255,7 +255,8 @@ int runStereo(const FrameBenchArgs& args, FrameRenderer& renderer, nlohmann::jso
     std::printf("\nTable 5%s: separate eyes vs binocular reuse on %s (%s backend), scene %s, both eyes %dx%d, "
                 "IPD %.0f mm, hash grid, radius estimate, hybrid kernel, photon-map-only shading, %d frames after %d "
                 "warm-up.\nright/left = right eye's time (scatter included) over the left eye's; reused = share of "
-                "right-eye pixels that took the left eye's shading; PSNR and >1%% = right eye against its separate "
+                "right-eye pixels that took the left eye's shading (in brackets: of those that see a surface, not the "
+                "background); PSNR and >1%% = right eye against its separate "
                 "rendering from the same photon map, displayed (sRGB).\n\n| photons | radius |",
                 si == 0 ? "" : " (other scenes)", r->deviceName().c_str(), r->name().c_str(), scene.name.c_str(),
                 rig.width, rig.height, rig.ipd * 1000.0f, args.frames, args.warmup);
@@ -288,28 +289,31 @@ int runStereo(const FrameBenchArgs& args, FrameRenderer& renderer, nlohmann::jso
         bool ok = leftSame && (c == 0 || q.psnr >= 30.0);
         failures += ok ? 0 : 1;
         double reuse = double(cell.last.reusedPixels) / (double(rig.width) * rig.height);
+        double surface = 0;  // right-eye pixels that see a surface (the rest is background)
+        for (uint32_t prim : reference.eyes[1].firstPrim) surface += prim != ~0u ? 1.0 : 0.0;
+        double reuseOfSurface = surface > 0 ? double(cell.last.reusedPixels) / surface : 0.0;
         double ratio = cell.eyeMs[0] > 0 ? cell.eyeMs[1] / cell.eyeMs[0] : 0.0;
         char psnr[32], line[512];
         if (c == 0) std::snprintf(psnr, sizeof psnr, "ref");
         else std::snprintf(psnr, sizeof psnr, "%.1f", q.psnr);  // prints inf for identical images
         std::snprintf(line, sizeof line,
-                      "| %ux%u | %g | %s | %.2f | %.3f | %.3f | %.3f | %.2f | %.1f%% | %s | %.2f%% | %s |\n",
+                      "| %ux%u | %g | %s | %.2f | %.3f | %.3f | %.3f | %.2f | %.1f%% (%.1f%%) | %s | %.2f%% | %s |\n",
                       row.photons, row.photons, row.radius, stereoModeName(modes[c]), cell.frameMs, cell.eyeMs[0],
-                      cell.eyeMs[1], cell.scatterMs, ratio, 100.0 * reuse, psnr, 100.0 * q.fractionOver1Percent,
-                      ok ? "ok" : "MISMATCH");
+                      cell.eyeMs[1], cell.scatterMs, ratio, 100.0 * reuse, 100.0 * reuseOfSurface, psnr,
+                      100.0 * q.fractionOver1Percent, ok ? "ok" : "MISMATCH");
         details += line;
         json.push_back({{"table", 5}, {"scene", scene.name}, {"photons", row.photons * row.photons},
                         {"photons_grid", row.photons}, {"radius", row.radius}, {"stereo", stereoModeName(modes[c])},
                         {"width", rig.width}, {"height", rig.height}, {"ipd_m", rig.ipd}, {"frame_ms", cell.frameMs},
                         {"left_eye_ms", cell.eyeMs[0]}, {"right_eye_ms", cell.eyeMs[1]},
-                        {"scatter_ms", cell.scatterMs}, {"right_left_ratio", ratio}, {"reused_fraction", reuse},
+                        {"scatter_ms", cell.scatterMs}, {"right_left_ratio", ratio}, {"reused_fraction", reuse}, {"reused_of_surface_fraction", reuseOfSurface},
                         {"psnr_db", c == 0 || std::isinf(q.psnr) ? nlohmann::json() : nlohmann::json(q.psnr)},
                         {"over_1pct_fraction", q.fractionOver1Percent}, {"check", ok ? "ok" : "MISMATCH"}});
       }
       std::fflush(stdout);
     }
     std::printf("\nTable 5%s per eye (ms per frame):\n\n| photons | radius | stereo | frame | left eye | right eye | "
-                "of which scatter | right/left | reused | PSNR dB | >1%% | check |\n"
+                "of which scatter | right/left | reused (of surface pixels) | PSNR dB | >1%% | check |\n"
                 "|---|---|---|---|---|---|---|---|---|---|---|---|\n%s",
                 si == 0 ? "" : " (other scenes)", details.c_str());
   }

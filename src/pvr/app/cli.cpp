@@ -170,9 +170,12 @@ int runRender(const RenderArgs& a) {
     std::printf(")\n");
   }
   if (options.stereo != StereoMode::Separate) {
-    double pixels = double(rig.width) * rig.height;
-    std::printf("  stereo %s: right eye reused %.1f%% of its pixels from the left; right/left time %.2f\n",
+    double pixels = double(rig.width) * rig.height, surface = 0;
+    for (uint32_t prim : frame.eyes[1].firstPrim) surface += prim != ~0u ? 1.0 : 0.0;
+    std::printf("  stereo %s: right eye reused %.1f%% of its pixels (%.1f%% of those that see a surface) from the "
+                "left; right/left time %.2f\n",
                 stereoModeName(options.stereo), 100.0 * double(frame.reusedPixels) / pixels,
+                surface > 0 ? 100.0 * double(frame.reusedPixels) / surface : 0.0,
                 frame.timings.eyeMs[0] > 0 ? frame.timings.eyeMs[1] / frame.timings.eyeMs[0] : 0.0);
   }
   if (frame.deviceBytes) std::printf("  GPU memory    %9.1f MiB\n", frame.deviceBytes / 1048576.0);
