@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config
-  libembree-dev libtbb-dev libassimp-dev
+  libembree-dev libtbb-dev libassimp-dev libcgal-dev
   libcli11-dev nlohmann-json3-dev libstb-dev libopenexr-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )

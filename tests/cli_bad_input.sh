@@ -43,6 +43,10 @@ expect_error "works on the hash grid" render cornell --kernel shared --map kdtre
 expect_error "--stereo must be" render cornell --stereo both --eye-size 8x8
 expect_error "needs both eyes" render cornell --stereo gather --eyes left --eye-size 8x8
 expect_error "--stereo must be" bench --suite stereo --backend cpu --stereo mirror --eye-size 8x8 --frames 1
+expect_error "--acuity must be" mask --acuity eagle --out "$out/m.pvrmask"
+expect_error "--margin must be" mask --margin -2 --out "$out/m.pvrmask"
+expect_error "--eye-size" mask --eye-size 0x5 --out "$out/m.pvrmask"
+expect_error "cannot write" mask --eye-size 32x32 --out /dev/null/m.pvrmask
 expect_error "--suite must be" bench --suite speed
 expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1

@@ -1,6 +1,7 @@
 #include "pvr/app/cli.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include <regex>
 
 #include "frame_bench.h"
+#include "pvr/foveation/mask.h"
 #include "map_bench.h"
 #include "pvr/render/image.h"
 #include "pvr/render/renderer.h"
@@ -41,6 +43,15 @@ float parseFloat(const std::string& text, const std::string& what) {
   } catch (const std::exception&) {
     throw Error(what + " must be a number, got '" + text + "'");
   }
+}
+
+// Creates the folder an output file goes into; a clear error if it cannot be made.
+void ensureParentDirectory(const std::string& file) {
+  std::filesystem::path parent = std::filesystem::path(file).parent_path();
+  if (parent.empty()) return;
+  std::error_code error;
+  std::filesystem::create_directories(parent, error);
+  if (error) throw Error("cannot write '" + file + "': cannot create folder '" + parent.string() + "' (" + error.message() + ")");
 }
 
 struct RenderArgs {
@@ -146,6 +157,7 @@ int runRender(const RenderArgs& a) {
   Scene scene = loadScene(a.scene);
   StereoRig rig = scene.rig;
   RenderOptions options = toOptions(a, rig);
+  ensureParentDirectory(a.out);  // before the work, not after it
   if (scene.skippedTriangles() > 0)
     std::cerr << "photonvr: warning: skipped " << scene.skippedTriangles()
               << " degenerate or non-finite triangles\n";
@@ -180,8 +192,6 @@ int runRender(const RenderArgs& a) {
   }
   if (frame.deviceBytes) std::printf("  GPU memory    %9.1f MiB\n", frame.deviceBytes / 1048576.0);
   std::printf("  total         %9.2f ms\n", frame.timings.totalMs());
-  std::filesystem::path prefix(a.out);
-  if (prefix.has_parent_path()) std::filesystem::create_directories(prefix.parent_path());
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;
     for (const char* ext : {".png", ".exr"}) {
@@ -199,6 +209,53 @@ int runRender(const RenderArgs& a) {
     writeImage(mask, path, 1.0f);
     std::printf("wrote %s (white: reused from the left eye; red: shaded by the right eye; black: background)\n", path.c_str());
   }
+  return 0;
+}
+
+struct MaskArgs {
+  std::string scene = "cornell";
+  std::string eyeSize;
+  std::string acuity = "linear";
+  float mar0 = 1.0f / 48.0f, slope = 0.022f, margin = 5.0f;
+  std::string out = "out/foveation.pvrmask";
+};
+
+int runMask(const MaskArgs& a) {
+  Scene scene = loadScene(a.scene);
+  StereoRig rig = scene.rig;
+  if (!a.eyeSize.empty()) {
+    Size2 s = parseSize(a.eyeSize, "--eye-size", false);
+    if (s.x < 1 || s.y < 1 || s.x > 8192 || s.y > 8192)
+      throw Error("--eye-size must be between 1x1 and 8192x8192, got '" + a.eyeSize + "'");
+    rig.width = int(s.x), rig.height = int(s.y);
+  }
+  MaskParams params;
+  params.width = rig.width, params.height = rig.height;
+  // The coarser of the two eyes' pixel sizes at the optical centre: never fewer samples than needed.
+  for (const Fov& f : rig.fov)
+    params.tanPerPixel = std::max({params.tanPerPixel, (std::tan(f.angleRight) - std::tan(f.angleLeft)) / float(rig.width),
+                                   (std::tan(f.angleUp) - std::tan(f.angleDown)) / float(rig.height)});
+  if (a.acuity == "linear") params.acuity.kind = AcuityKind::LinearMar;
+  else if (a.acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
+  else throw Error("--acuity must be linear or geisler-perry, got '" + a.acuity + "'");
+  if (!(a.mar0 > 0.0f && a.mar0 < 10.0f)) throw Error("--mar0 must be between 0 and 10 degrees");
+  if (!(a.slope >= 0.0f && a.slope < 1.0f)) throw Error("--slope must be between 0 and 1");
+  if (!(a.margin >= 0.0f && a.margin <= 90.0f)) throw Error("--margin must be between 0 and 90 degrees");
+  params.acuity.mar0Deg = a.mar0, params.acuity.marSlope = a.slope, params.acuity.gazeMarginDeg = a.margin;
+  FoveationMask mask = generateFoveationMask(params);
+  ensureParentDirectory(a.out);
+  saveFoveationMask(mask, a.out);
+  std::vector<uint8_t> used = verticesInUse(mask, rig.width / 2, rig.height / 2);
+  size_t shaded = 0;
+  for (uint8_t u : used) shaded += u;
+  double pixels = double(rig.width) * rig.height;
+  std::printf("mask for %dx%d per eye (%.4f tan/pixel), %s acuity, full density within %.1f deg (%d pixels) of the gaze\n",
+              rig.width, rig.height, params.tanPerPixel, a.acuity.c_str(),
+              eccentricityDeg(mask.fullDensityRadius, params.tanPerPixel), mask.fullDensityRadius);
+  std::printf("  %zu vertices, %zu Delaunay triangles; with the gaze at the image centre %zu samples are shaded "
+              "per eye: %.1fx fewer than the %.0f pixels\n",
+              mask.offsets.size(), mask.triangleCount(), shaded, pixels / double(std::max<size_t>(shaded, 1)), pixels);
+  std::printf("wrote %s\n", a.out.c_str());
   return 0;
 }
 
@@ -263,8 +320,22 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   bench->add_option("--json", ba.json, "Also write the results as JSON to this file");
 
+  MaskArgs ma;
+  CLI::App* maskCmd = app.add_subcommand(
+      "mask", "Make a foveation sampling mask (acuity-driven samples, Delaunay-triangulated by CGAL) for a scene's headset rig");
+  maskCmd->add_option("scene", ma.scene, "Scene whose rig (eye size, FOV) the mask is for")->capture_default_str();
+  maskCmd->add_option("--eye-size", ma.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
+  maskCmd->add_option("--acuity", ma.acuity, "linear (MAR = omega0 + m e, Guenter et al. 2012) | geisler-perry")
+      ->capture_default_str();
+  maskCmd->add_option("--mar0", ma.mar0, "omega0: MAR at the fovea, degrees")->capture_default_str();
+  maskCmd->add_option("--slope", ma.slope, "m: MAR growth, degrees per degree of eccentricity")->capture_default_str();
+  maskCmd->add_option("--margin", ma.margin, "Full density this many degrees around the gaze (eye-tracking error)")
+      ->capture_default_str();
+  maskCmd->add_option("--out", ma.out, "Mask file to write")->capture_default_str();
+
   try {
     app.parse(argc, argv);
+    if (maskCmd->parsed()) return runMask(ma);
     if (render->parsed()) return runRender(ra);
     if (bench->parsed()) {
       if (fa.suite == "maps") return runMapBench(ba);

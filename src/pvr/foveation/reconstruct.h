@@ -1,0 +1,62 @@
+#pragma once
+// Reconstruction of an eye's image from the colours of a foveation mask's vertices: the mask's
+// triangles are rasterized and each pixel centre takes the barycentric blend of its triangle's
+// vertex colours. Host+device: the CPU backend and a CUDA raster kernel share it.
+//
+// Every pixel centre inside the mask belongs to exactly one triangle: edge functions are
+// evaluated the same way (endpoints in vertex-index order) by both triangles of a shared edge, so
+// their signs agree exactly, and a centre exactly on an edge or vertex goes to one side by the
+// top-left rule.
+#include "pvr/math/vec.h"
+
+namespace pvr {
+
+struct MaskPoint {
+  float x = 0, y = 0;
+};
+
+// Twice the signed area of (a, b, p), in double: positive when p lies to the left of a -> b.
+PVR_HOST_DEVICE inline double orient2d(MaskPoint a, MaskPoint b, double px, double py) {
+  return (double(b.x) - double(a.x)) * (py - double(a.y)) - (double(b.y) - double(a.y)) * (px - double(a.x));
+}
+
+// The edge a -> b of a triangle, evaluated identically by both triangles that share it.
+PVR_HOST_DEVICE inline double edgeFunction(MaskPoint a, uint32_t ia, MaskPoint b, uint32_t ib, double px, double py) {
+  return ia < ib ? orient2d(a, b, px, py) : -orient2d(b, a, px, py);
+}
+
+// Ties on an edge belong to the triangle for which the edge runs "upwards" (or leftwards when
+// horizontal): of the two directions of a shared edge exactly one qualifies.
+PVR_HOST_DEVICE inline bool ownsEdgeTie(MaskPoint a, MaskPoint b) {
+  float dx = b.x - a.x, dy = b.y - a.y;
+  return dy > 0.0f || (dy == 0.0f && dx < 0.0f);
+}
+
+// Barycentric weights of (px, py) in the triangle (v, index), or false if the point is not
+// covered by it. The triangle may have either orientation; degenerate ones cover nothing.
+PVR_HOST_DEVICE inline bool coveredBy(const MaskPoint v[3], const uint32_t index[3], double px, double py,
+                                      double weight[3]) {
+  int i1 = 1, i2 = 2;
+  double area = orient2d(v[0], v[1], double(v[2].x), double(v[2].y));
+  if (area == 0.0) return false;
+  if (area < 0.0) i1 = 2, i2 = 1, area = -area;  // make the triangle counter-clockwise
+  const int order[3] = {0, i1, i2};
+  double w[3];
+  for (int e = 0; e < 3; ++e) {
+    int a = order[e], b = order[(e + 1) % 3];
+    double f = edgeFunction(v[a], index[a], v[b], index[b], px, py);
+    if (f < 0.0 || (f == 0.0 && !ownsEdgeTie(v[a], v[b]))) return false;
+    w[order[(e + 2) % 3]] = f;  // the edge's function weighs the opposite vertex
+  }
+  double sum = w[0] + w[1] + w[2];
+  for (int k = 0; k < 3; ++k) weight[k] = w[k] / sum;
+  return true;
+}
+
+PVR_HOST_DEVICE inline Vec3 blend(const double weight[3], Vec3 c0, Vec3 c1, Vec3 c2) {
+  return {float(weight[0] * c0.x + weight[1] * c1.x + weight[2] * c2.x),
+          float(weight[0] * c0.y + weight[1] * c1.y + weight[2] * c2.y),
+          float(weight[0] * c0.z + weight[1] * c1.z + weight[2] * c2.z)};
+}
+
+}  // namespace pvr
