@@ -47,6 +47,14 @@ expect_error "--acuity must be" mask --acuity eagle --out "$out/m.pvrmask"
 expect_error "--margin must be" mask --margin -2 --out "$out/m.pvrmask"
 expect_error "--eye-size" mask --eye-size 0x5 --out "$out/m.pvrmask"
 expect_error "cannot write" mask --eye-size 32x32 --out /dev/null/m.pvrmask
+expect_error "--gaze must be" render cornell --foveated --gaze 2,0.5 --eye-size 8x8
+expect_error "--gaze must be" render cornell --foveated --gaze 0.5 --eye-size 8x8
+expect_error "cannot open mask file" render cornell --foveated --mask "$data/missing.pvrmask" --eye-size 8x8
+expect_error "not a photonvr mask" render cornell --foveated --mask "$data/box.obj" --eye-size 8x8
+expect_error "only for\|is for --foveated" render cornell --mask "$data/box.obj" --eye-size 8x8
+expect_error "not implemented yet" render cornell --foveated --stereo gather --eye-size 16x16
+"$exe" mask --eye-size 32x32 --out "$out/m32.pvrmask" >/dev/null 2>&1
+expect_error "mask is for 32x32" render cornell --foveated --mask "$out/m32.pvrmask" --eye-size 16x16
 expect_error "--suite must be" bench --suite speed
 expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1

@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "pvr/foveation/mask.h"
+#include "pvr/render/renderer.h"
 #include "pvr/util/error.h"
 
 namespace pvr {
@@ -208,6 +209,41 @@ TEST(FoveationMask, RejectsBadParameters) {
   p = smallParams();
   p.width = 0;
   EXPECT_THROW(generateFoveationMask(p), Error);
+}
+
+TEST(FoveatedRender, TheFoveaIsTheFullResolutionImageAndFewerSamplesAreShaded) {
+  Scene scene = builtinScene("cornell");
+  CpuBackend backend(scene);
+  StereoRig rig = scene.rig;
+  rig.width = 160, rig.height = 176;
+  MaskParams params = smallParams();
+  params.tanPerPixel = (std::tan(rig.fov[0].angleUp) - std::tan(rig.fov[0].angleDown)) / float(rig.height);
+  FoveationMask mask = generateFoveationMask(params);
+  RenderOptions o;
+  o.photonsX = o.photonsY = 96;
+  o.gather.density.radius = 0.06f;
+  FrameResult full = renderFrame(backend, rig, o);
+  o.foveation.mask = &mask;
+  o.foveation.gaze[0][0] = 0.4f, o.foveation.gaze[0][1] = 0.55f;
+  FrameResult foveated = renderFrame(backend, rig, o);
+  for (int e = 0; e < 2; ++e) {
+    int gx, gy;
+    o.foveation.gazePixel(e, rig.width, rig.height, gx, gy);
+    size_t inside = 0;
+    for (int y = 0; y < rig.height; ++y)
+      for (int x = 0; x < rig.width; ++x) {
+        if ((x - gx) * (x - gx) + (y - gy) * (y - gy) > mask.fullDensityRadius * mask.fullDensityRadius) continue;
+        ++inside;
+        const Vec3 &a = foveated.eyes[e].image.at(x, y), &b = full.eyes[e].image.at(x, y);
+        ASSERT_TRUE(a.x == b.x && a.y == b.y && a.z == b.z) << "eye " << e << " pixel " << x << "," << y;
+      }
+    EXPECT_GT(inside, 500u);
+    EXPECT_LT(foveated.shadedSamples[e], full.shadedSamples[e]);
+    EXPECT_EQ(full.shadedSamples[e], size_t(rig.width) * rig.height);
+  }
+  // A mask for another eye size is refused.
+  rig.width = 150;
+  EXPECT_THROW(renderFrame(backend, rig, o), Error);
 }
 
 }  // namespace

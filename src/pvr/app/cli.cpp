@@ -72,6 +72,9 @@ struct RenderArgs {
   int photonDepth = 8;
   int specularDepth = 8;
   std::string shading = "full";
+  bool foveated = false;
+  std::string mask;          // empty: made for the rig at start
+  std::string gaze = "0.5,0.5";
   std::string out = "out/render";
   float exposure = 1.0f;
 };
@@ -152,11 +155,37 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   return o;
 }
 
+// The mask generator's parameters for a rig: the coarser of the two eyes' pixels at the optical
+// centre, so that the mask never has fewer samples than either eye needs.
+MaskParams maskParamsFor(const StereoRig& rig) {
+  MaskParams params;
+  params.width = rig.width, params.height = rig.height;
+  for (const Fov& f : rig.fov)
+    params.tanPerPixel = std::max({params.tanPerPixel, (std::tan(f.angleRight) - std::tan(f.angleLeft)) / float(rig.width),
+                                   (std::tan(f.angleUp) - std::tan(f.angleDown)) / float(rig.height)});
+  return params;
+}
+
 int runRender(const RenderArgs& a) {
   BackendKind backendKind = parseBackendKind(a.backend);
   Scene scene = loadScene(a.scene);
   StereoRig rig = scene.rig;
   RenderOptions options = toOptions(a, rig);
+  FoveationMask mask;
+  if (a.foveated) {
+    float gx = 0, gy = 0;
+    char extra = 0;
+    if (std::sscanf(a.gaze.c_str(), "%f,%f%c", &gx, &gy, &extra) != 2 || !(gx >= 0.0f && gx <= 1.0f) ||
+        !(gy >= 0.0f && gy <= 1.0f))
+      throw Error("--gaze must be X,Y with both in [0, 1] (image fractions, 0.5,0.5 = centre), got '" + a.gaze + "'");
+    mask = a.mask.empty() ? generateFoveationMask(maskParamsFor(rig)) : loadFoveationMask(a.mask);
+    checkMaskFits(mask, rig.width, rig.height);
+    options.foveation.mask = &mask;
+    for (auto& g : options.foveation.gaze) g[0] = gx, g[1] = gy;
+    validateOptions(options, rig);
+  } else if (!a.mask.empty()) {
+    throw Error("--mask is for --foveated rendering");
+  }
   ensureParentDirectory(a.out);  // before the work, not after it
   if (scene.skippedTriangles() > 0)
     std::cerr << "photonvr: warning: skipped " << scene.skippedTriangles()
@@ -190,6 +219,11 @@ int runRender(const RenderArgs& a) {
                 surface > 0 ? 100.0 * double(frame.reusedPixels) / surface : 0.0,
                 frame.timings.eyeMs[0] > 0 ? frame.timings.eyeMs[1] / frame.timings.eyeMs[0] : 0.0);
   }
+  if (options.foveation.mask)
+    std::printf("  foveated: %zu + %zu samples shaded (%.1fx fewer than the pixels), mask of %zu vertices\n",
+                frame.shadedSamples[0], frame.shadedSamples[1],
+                2.0 * rig.width * rig.height / double(std::max<size_t>(frame.shadedSamples[0] + frame.shadedSamples[1], 1)),
+                mask.offsets.size());
   if (frame.deviceBytes) std::printf("  GPU memory    %9.1f MiB\n", frame.deviceBytes / 1048576.0);
   std::printf("  total         %9.2f ms\n", frame.timings.totalMs());
   for (int e = 0; e < 2; ++e) {
@@ -229,12 +263,7 @@ int runMask(const MaskArgs& a) {
       throw Error("--eye-size must be between 1x1 and 8192x8192, got '" + a.eyeSize + "'");
     rig.width = int(s.x), rig.height = int(s.y);
   }
-  MaskParams params;
-  params.width = rig.width, params.height = rig.height;
-  // The coarser of the two eyes' pixel sizes at the optical centre: never fewer samples than needed.
-  for (const Fov& f : rig.fov)
-    params.tanPerPixel = std::max({params.tanPerPixel, (std::tan(f.angleRight) - std::tan(f.angleLeft)) / float(rig.width),
-                                   (std::tan(f.angleUp) - std::tan(f.angleDown)) / float(rig.height)});
+  MaskParams params = maskParamsFor(rig);
   if (a.acuity == "linear") params.acuity.kind = AcuityKind::LinearMar;
   else if (a.acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
   else throw Error("--acuity must be linear or geisler-perry, got '" + a.acuity + "'");
@@ -287,6 +316,11 @@ int runCli(int argc, char** argv) {
                      "alone, the paper's formulation)")
       ->capture_default_str();
   render->add_option("--exposure", ra.exposure, "Scale applied before the sRGB PNG's clamp")->capture_default_str();
+  render->add_flag("--foveated", ra.foveated,
+                   "Foveated: shade only a foveation mask's vertices around the gaze and reconstruct (CPU backend)");
+  render->add_option("--mask", ra.mask, "Foveation mask file from `photonvr mask` (default: made for the rig at start)");
+  render->add_option("--gaze", ra.gaze, "Gaze point X,Y as fractions of the image (0.5,0.5 = centre)")
+      ->capture_default_str();
   render->add_option("--out", ra.out, "Output prefix: writes PREFIX_left.png/.exr and PREFIX_right.png/.exr")
       ->capture_default_str();
 

@@ -53,6 +53,37 @@ void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams&
   renderEyeWith(camera, eye, params, map, out, reuse, surfaces);
 }
 
+template <class Map>
+Image CpuBackend::renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                                        const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const {
+  SceneView view = scene_.view();
+  std::vector<uint8_t> used = verticesInUse(mask, gazeX, gazeY);
+  std::vector<uint32_t> vertices;
+  for (uint32_t i = 0; i < used.size(); ++i)
+    if (used[i]) vertices.push_back(i);
+  shaded = vertices.size();
+  std::vector<Vec3> colours(mask.offsets.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const MaskPoint& o = mask.offsets[vertices[k]];
+      colours[vertices[k]] = shadeImagePosition(view, intersector_, map, params, camera, eye,
+                                                o.x + float(gazeX) + 0.5f, o.y + float(gazeY) + 0.5f);
+    }
+  });
+  return reconstructFoveatedImage(mask, gazeX, gazeY, colours);
+}
+
+Image CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params,
+                                    const HashGridView& map, const FoveationMask& mask, int gazeX, int gazeY,
+                                    size_t& shaded) const {
+  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, shaded);
+}
+
+Image CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                                    const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const {
+  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, shaded);
+}
+
 size_t CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target,
                            uint64_t* scattered) const {
   SceneView view = scene_.view();

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "pvr/cpu/embree_intersector.h"
+#include "pvr/foveation/mask.h"
 #include "pvr/photon/gather.h"
 #include "pvr/photon/hash_grid.h"
 #include "pvr/photon/kd_tree.h"
@@ -28,6 +29,13 @@ class CpuBackend {
                  PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
                  SurfaceRecord* surfaces = nullptr) const;
 
+  // Foveated: shades the mask's vertices in use for the gaze pixel (gazeX, gazeY) and reconstructs
+  // the eye's image from them; `shaded` is the number of vertices shaded.
+  Image renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
+                          const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const;
+  Image renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                          const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const;
+
   // Scatter: projects every reusable source pixel's surface into `target`'s image, keeping the
   // nearest per target pixel in `scattered` (width * height entries, filled with kNothingScattered
   // here). Returns the number of source points written.
@@ -37,6 +45,9 @@ class CpuBackend {
   const EmbreeIntersector& intersector() const { return intersector_; }
 
  private:
+  template <class Map>
+  Image renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                              const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const;
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
                      PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const;

@@ -48,6 +48,25 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
   }
   frame.timings.mapBuildMs = msSince(start);
 
+  if (const FoveationMask* mask = options.foveation.mask) {
+    checkMaskFits(*mask, rig.width, rig.height);
+    for (int e = 0; e < 2; ++e) {
+      if (!options.eyes[e]) continue;
+      int gx, gy;
+      options.foveation.gazePixel(e, rig.width, rig.height, gx, gy);
+      start = std::chrono::steady_clock::now();
+      EyeCamera camera = rig.eye(Eye(e));
+      if (options.map == PhotonMapKind::HashGrid)
+        frame.eyes[e].image = backend.renderFoveatedEye(camera, Eye(e), options.gather, grid.view(), *mask, gx, gy,
+                                                        frame.shadedSamples[e]);
+      else
+        frame.eyes[e].image = backend.renderFoveatedEye(camera, Eye(e), options.gather, tree.view(), *mask, gx, gy,
+                                                        frame.shadedSamples[e]);
+      frame.timings.eyeMs[e] = frame.timings.eyeRayMs[e] = msSince(start);
+    }
+    return frame;
+  }
+
   // The left eye first: under stereo reuse the right eye reads its surfaces and finished image.
   const bool reusing = options.stereo != StereoMode::Separate;
   std::vector<PixelSample> samples;
@@ -81,6 +100,7 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
       backend.renderEye(camera, Eye(e), options.gather, tree.view(), samples.data(), reuse, surfaces);
     frame.timings.eyeRayMs[e] = msSince(eyeStart);  // one fused pass, like the single kernel
     frame.timings.eyeMs[e] = msSince(start);
+    frame.shadedSamples[e] = samples.size();
     out.image = Image(camera.width, camera.height);
     out.firstPrim.resize(samples.size());
     for (size_t i = 0; i < samples.size(); ++i) {

@@ -61,6 +61,8 @@ size_t CudaFrameRenderer::deviceBytes() const { return cuda::deviceBytesInUse();
 
 FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
   validateOptions(options, rig);
+  if (options.foveation.mask)
+    throw Error("foveated rendering runs on the CPU backend so far (--backend cpu); its CUDA raster kernel is not written yet");
   Impl& m = *impl_;
   FrameResult frame;
   PhotonTraceParams traceParams = options.photonTraceParams();
@@ -110,6 +112,7 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
     frame.timings.eyeRayMs[e] = m.eyeTimers[e].raysMs();
     frame.timings.densityMs[e] = m.eyeTimers[e].densityMs();
     frame.timings.eyeMs[e] = frame.timings.eyeRayMs[e] + frame.timings.densityMs[e];
+    frame.shadedSamples[e] = size_t(rig.width) * rig.height;
   }
   frame.timings.eyeMs[1] += frame.timings.scatterMs;
   frame.deviceBytes = cuda::deviceBytesInUse();

@@ -4,6 +4,9 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -197,20 +200,31 @@ Image reconstructFoveatedImage(const FoveationMask& mask, int gazeX, int gazeY, 
   if (vertexColours.size() != mask.offsets.size()) throw Error("reconstruction needs one colour per mask vertex");
   const int w = mask.params.width, h = mask.params.height;
   Image image(w, h);
-  for (size_t t = 0; t < mask.triangleCount(); ++t) {
-    MaskPoint v[3];
-    uint32_t index[3];
-    placedTriangle(mask, t, gazeX, gazeY, v, index);
-    int x0, x1, y0, y1;
-    if (!triangleBounds(v, w, h, x0, x1, y0, y1)) continue;
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x) {
-        double weight[3];
-        if (coveredBy(v, index, x + 0.5, y + 0.5, weight))
-          image.at(x, y) = blend(weight, vertexColours[index[0]], vertexColours[index[1]], vertexColours[index[2]]);
-      }
-  }
+  // Each pixel centre belongs to one triangle: triangles write disjoint pixels, in parallel.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mask.triangleCount(), 512), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t < r.end(); ++t) {
+      MaskPoint v[3];
+      uint32_t index[3];
+      placedTriangle(mask, t, gazeX, gazeY, v, index);
+      int x0, x1, y0, y1;
+      if (!triangleBounds(v, w, h, x0, x1, y0, y1)) continue;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          double weight[3];
+          if (coveredBy(v, index, x + 0.5, y + 0.5, weight))
+            image.at(x, y) = blend(weight, vertexColours[index[0]], vertexColours[index[1]], vertexColours[index[2]]);
+        }
+    }
+  });
   return image;
+}
+
+void checkMaskFits(const FoveationMask& mask, int width, int height) {
+  if (mask.params.width != width || mask.params.height != height)
+    throw Error("the foveation mask is for " + std::to_string(mask.params.width) + "x" +
+                std::to_string(mask.params.height) + " eyes, the render is " + std::to_string(width) + "x" +
+                std::to_string(height) + " (make one with `photonvr mask --eye-size " + std::to_string(width) + "x" +
+                std::to_string(height) + "`)");
 }
 
 std::vector<uint8_t> verticesInUse(const FoveationMask& mask, int gazeX, int gazeY) {

@@ -51,6 +51,9 @@ FoveationMask loadFoveationMask(const std::string& path);
 // inside the image).
 Image reconstructFoveatedImage(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours);
 
+// Throws pvr::Error unless the mask was made for this eye size.
+void checkMaskFits(const FoveationMask& mask, int width, int height);
+
 // Vertices whose triangles overlap the image for this gaze (the only ones that need shading).
 std::vector<uint8_t> verticesInUse(const FoveationMask& mask, int gazeX, int gazeY);
 

@@ -55,6 +55,13 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
   if ((o.kernel == DensityKernel::SharedMemory || o.kernel == DensityKernel::CellSorted) &&
       o.map != PhotonMapKind::HashGrid)
     throw Error(std::string("the ") + densityKernelName(o.kernel) + " kernel works on the hash grid, not the kd-tree");
+  if (o.foveation.mask) {
+    for (int e = 0; e < 2; ++e)
+      for (float g : o.foveation.gaze[e])
+        if (!(g >= 0.0f && g <= 1.0f)) throw Error("the gaze must lie in the image: coordinates between 0 and 1");
+    if (o.stereo != StereoMode::Separate)
+      throw Error("foveated rendering with stereo reuse is not implemented yet: use --stereo separate");
+  }
   if (o.stereo != StereoMode::Separate && !(o.eyes[0] && o.eyes[1]))
     throw Error(std::string("stereo reuse (") + stereoModeName(o.stereo) + ") renders the right eye from the left: it needs both eyes");
 }

@@ -2,6 +2,7 @@
 // One stereo frame, whatever the backend: its options (photons, photon map, density estimation,
 // GPU kernel scheme), the time of each stage, and the images. The CPU backend (Embree + TBB) is
 // the reference; the CUDA backend must agree with it.
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,20 @@
 #include "pvr/photon/photon_trace.h"
 
 namespace pvr {
+
+struct FoveationMask;  // pvr/foveation/mask.h
+
+// Foveated rendering: rays only through the mask's vertices around each eye's gaze, the image
+// reconstructed from them (the foveated ray tracing document).
+struct FoveationOptions {
+  const FoveationMask* mask = nullptr;  ///< null: every pixel is shaded
+  float gaze[2][2] = {{0.5f, 0.5f}, {0.5f, 0.5f}};  ///< per eye, gaze point in [0, 1]^2 of the image (x right, y down)
+  // The gaze's pixel for an eye of width x height.
+  void gazePixel(int eye, int width, int height, int& x, int& y) const {
+    x = std::min(width - 1, std::max(0, int(gaze[eye][0] * float(width))));
+    y = std::min(height - 1, std::max(0, int(gaze[eye][1] * float(height))));
+  }
+};
 
 enum class PhotonMapKind : int { HashGrid = 0, KdTree = 1 };
 
@@ -36,6 +51,7 @@ struct RenderOptions {
   GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
   bool eyes[2] = {true, true};
   StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading
+  FoveationOptions foveation;
   uint32_t photonCount() const { return photonsX * photonsY; }
   // The photon pass these options ask for (every backend traces the same photons).
   PhotonTraceParams photonTraceParams() const {
@@ -74,6 +90,7 @@ struct FrameResult {
   size_t mapBytes = 0;
   size_t deviceBytes = 0;  ///< GPU memory held by the backend (0 on the CPU)
   size_t reusedPixels = 0;  ///< right-eye pixels that took the left eye's shading
+  size_t shadedSamples[2] = {0, 0};  ///< per eye: pixels, or mask vertices when foveated
 };
 
 // Checks options against the rig; throws pvr::Error naming the bad value.

@@ -106,15 +106,34 @@ PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector&
   return finishGather(map, traceToDiffuse(scene, intersector, params, ray, rng), params.density);
 }
 
+// The random numbers of sample s of one pixel of one eye.
+PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, Eye eye, uint32_t pixelIndex, int s) {
+  return CounterRng(hashCombine(params.seed, 0x51ed270bu + uint32_t(eye)), pixelIndex, uint32_t(s));
+}
+
 // The camera ray of sample s of pixel (x, y), with the random numbers that continue its path. The
 // first sample goes through the pixel centre, so the first-hit id is stable.
 PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
                                           int s, CounterRng& rng) {
-  uint32_t pixelIndex = uint32_t(y) * uint32_t(camera.width) + uint32_t(x);
-  uint32_t eyeSeed = hashCombine(params.seed, 0x51ed270bu + uint32_t(eye));
-  rng = CounterRng(eyeSeed, pixelIndex, uint32_t(s));
+  rng = pixelRng(params, eye, uint32_t(y) * uint32_t(camera.width) + uint32_t(x), s);
   float jx = s == 0 ? 0.5f : rng.uniform(), jy = s == 0 ? 0.5f : rng.uniform();
   return camera.generateRay(float(x) + jx, float(y) + jy);
+}
+
+// The radiance seen through a continuous image position (a foveation mask's vertex), with the
+// random numbers of the pixel it lies in: a vertex on a pixel centre is shaded exactly as that
+// pixel's first sample. Positions outside the image get streams of their own.
+template <class Intersector, class PhotonMap>
+PVR_HOST_DEVICE Vec3 shadeImagePosition(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
+                                        const GatherParams& params, const EyeCamera& camera, Eye eye, float px,
+                                        float py) {
+  int ix = int(floorf(px)), iy = int(floorf(py));
+  bool inside = ix >= 0 && iy >= 0 && ix < camera.width && iy < camera.height;
+  uint32_t stream = inside ? uint32_t(iy) * uint32_t(camera.width) + uint32_t(ix)
+                           : hashCombine(hashCombine(0x9e3779b9u, uint32_t(ix)), uint32_t(iy)) | 0x80000000u;
+  CounterRng rng = pixelRng(params, eye, stream, 0);
+  Ray ray = camera.generateRay(px, py);
+  return finishGather(map, traceToDiffuse(scene, intersector, params, ray, rng), params.density);
 }
 
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
