@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "pvr/foveation/mask.h"
 #include "pvr/render/image_compare.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
@@ -114,7 +115,7 @@ ImageDiff compareImages(const Image& a, const Image& b) {
 
 struct CellResult {
   double frameMs = 0, traceMs = 0, buildMs = 0, raysMs = 0, densityMs = 0;
-  double eyeMs[2] = {0, 0}, scatterMs = 0;
+  double eyeMs[2] = {0, 0}, scatterMs = 0, reconstructMs = 0;
   size_t stored = 0, deviceBytes = 0, mapBytes = 0, reusedPixels = 0;
   FrameResult last;  ///< a frame with images, for the checks
 };
@@ -133,6 +134,7 @@ CellResult timeCell(FrameRenderer& renderer, const StereoRig& rig, const RenderO
     r.eyeMs[0] += f.timings.eyeMs[0];
     r.eyeMs[1] += f.timings.eyeMs[1];
     r.scatterMs += f.timings.scatterMs;
+    r.reconstructMs += f.timings.reconstructMs[0] + f.timings.reconstructMs[1];
     r.reusedPixels = f.reusedPixels;
     r.stored = f.storedPhotons;
     r.deviceBytes = std::max(r.deviceBytes, f.deviceBytes);
@@ -140,7 +142,7 @@ CellResult timeCell(FrameRenderer& renderer, const StereoRig& rig, const RenderO
   }
   double n = std::max(frames, 1);
   r.frameMs /= n, r.traceMs /= n, r.buildMs /= n, r.raysMs /= n, r.densityMs /= n;
-  r.eyeMs[0] /= n, r.eyeMs[1] /= n, r.scatterMs /= n;
+  r.eyeMs[0] /= n, r.eyeMs[1] /= n, r.scatterMs /= n, r.reconstructMs /= n;
   r.last = renderer.render(rig, o, true);
   return r;
 }
@@ -320,6 +322,90 @@ int runStereo(const FrameBenchArgs& args, FrameRenderer& renderer, nlohmann::jso
   return failures;
 }
 
+// Foveated rendering against full resolution: shaded samples, eye-pass time, and quality in rings
+// of eccentricity around the gaze (PSNR of the displayed image against the full-resolution one).
+int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& renderer, const StereoRig& rig,
+                 nlohmann::json& json) {
+  MaskParams params;
+  params.width = rig.width, params.height = rig.height;
+  for (const Fov& f : rig.fov)
+    params.tanPerPixel = std::max({params.tanPerPixel, (std::tan(f.angleRight) - std::tan(f.angleLeft)) / float(rig.width),
+                                   (std::tan(f.angleUp) - std::tan(f.angleDown)) / float(rig.height)});
+  FoveationMask linear = generateFoveationMask(params);
+  params.acuity.kind = AcuityKind::GeislerPerry;
+  FoveationMask geislerPerry = generateFoveationMask(params);
+  struct Column {
+    std::string name;
+    const FoveationMask* mask;
+    float gazeX, gazeY;
+  };
+  const std::vector<Column> columns = {{"full resolution", nullptr, 0.5f, 0.5f},
+                                       {"foveated, linear MAR", &linear, 0.5f, 0.5f},
+                                       {"foveated, Geisler-Perry", &geislerPerry, 0.5f, 0.5f},
+                                       {"foveated, linear MAR, gaze (0.3, 0.6)", &linear, 0.3f, 0.6f}};
+  const std::vector<std::pair<float, float>> rings = {{0, 5}, {5, 10}, {10, 20}, {20, 40}, {40, 180}};
+  std::printf("\nFoveated rendering on %s (%s backend): scene %s, both eyes %dx%d, 512x512 photons, r = 0.05, radius "
+              "estimate, photon-map-only shading, %d frames after %d warm-up. Masks: %zu vertices (linear MAR, "
+              "omega0 = 1/48 deg, m = 0.022, %g deg margin), %zu (Geisler-Perry). PSNR: left eye against full "
+              "resolution, displayed (sRGB), in rings of eccentricity from the gaze.\n\n"
+              "| variant | frame ms | eye pass ms (both) | of which reconstruction | samples per eye | fewer | eye pass "
+              "speed-up | PSNR 0-5 deg | 5-10 | 10-20 | 20-40 | >40 | check |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+              renderer.deviceName().c_str(), renderer.name().c_str(), scene.name.c_str(), rig.width, rig.height,
+              args.frames, args.warmup, linear.offsets.size(), double(params.acuity.gazeMarginDeg),
+              geislerPerry.offsets.size());
+  int failures = 0;
+  double fullEyeMs = 0;
+  FrameResult reference;
+  for (size_t c = 0; c < columns.size(); ++c) {
+    RenderOptions o;
+    o.photonsX = o.photonsY = 512;
+    o.gather.mode = ShadingMode::PhotonMapOnly;
+    o.gather.density.radius = 0.05f;
+    o.foveation.mask = columns[c].mask;
+    for (auto& g : o.foveation.gaze) g[0] = columns[c].gazeX, g[1] = columns[c].gazeY;
+    CellResult cell = timeCell(renderer, rig, o, args.warmup, args.frames);
+    double eyeMs = cell.eyeMs[0] + cell.eyeMs[1];
+    if (c == 0) fullEyeMs = eyeMs, reference = cell.last;
+    // Eccentricity of each pixel of the left eye from the gaze direction.
+    EyeCamera camera = rig.eye(Eye::Left);
+    int gx, gy;
+    o.foveation.gazePixel(0, rig.width, rig.height, gx, gy);
+    Vec3 gazeDir = camera.generateRay(gx + 0.5f, gy + 0.5f).dir;
+    std::vector<float> eccentricity(size_t(rig.width) * rig.height);
+    for (int y = 0; y < rig.height; ++y)
+      for (int x = 0; x < rig.width; ++x)
+        eccentricity[size_t(y) * rig.width + x] =
+            std::acos(std::clamp(dot(camera.generateRay(x + 0.5f, y + 0.5f).dir, gazeDir), -1.0f, 1.0f)) * 180.0f / kPi;
+    std::vector<double> psnr;
+    for (auto [lo, hi] : rings) {
+      std::vector<uint8_t> ring(eccentricity.size());
+      for (size_t i = 0; i < ring.size(); ++i) ring[i] = eccentricity[i] >= lo && eccentricity[i] < hi ? 1 : 0;
+      psnr.push_back(compareDisplayed(cell.last.eyes[0].image, reference.eyes[0].image, ring).psnr);
+    }
+    double pixels = double(rig.width) * rig.height;
+    double samples = double(cell.last.shadedSamples[0]);
+    // Self-check: the fovea of a foveated image is the full-resolution image there.
+    bool ok = c == 0 || psnr[0] >= 40.0;
+    failures += ok ? 0 : 1;
+    std::printf("| %s | %.2f | %.3f | %.3f | %.0f | %.1fx | %.2fx |", columns[c].name.c_str(), cell.frameMs, eyeMs,
+                cell.reconstructMs, samples, pixels / std::max(samples, 1.0), fullEyeMs / std::max(eyeMs, 1e-9));
+    for (double p : psnr) std::printf(c == 0 ? " ref |" : " %.1f |", p);
+    std::printf(" %s |\n", ok ? "ok" : "MISMATCH");
+    nlohmann::json ringJson = nlohmann::json::array();
+    for (size_t r = 0; r < rings.size(); ++r)
+      ringJson.push_back({{"from_deg", rings[r].first}, {"to_deg", rings[r].second},
+                          {"psnr_db", c == 0 || std::isinf(psnr[r]) ? nlohmann::json() : nlohmann::json(psnr[r])}});
+    json.push_back({{"suite", "foveation"}, {"scene", scene.name}, {"variant", columns[c].name},
+                    {"width", rig.width}, {"height", rig.height}, {"frame_ms", cell.frameMs}, {"eye_pass_ms", eyeMs},
+                    {"reconstruct_ms", cell.reconstructMs}, {"samples_per_eye", samples}, {"pixels_per_eye", pixels},
+                    {"eye_pass_speedup", fullEyeMs / std::max(eyeMs, 1e-9)}, {"rings", ringJson},
+                    {"check", ok ? "ok" : "MISMATCH"}});
+    std::fflush(stdout);
+  }
+  std::printf("\nNot measured yet: temporal flicker with and without TAA (TAA is not implemented).\n");
+  return failures;
+}
+
 #ifdef PVR_HAVE_CUDA
 int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
   int failures = 0;
@@ -401,8 +487,8 @@ int runGrid(const FrameBenchArgs& args, nlohmann::json& json) {
 
 int runFrameBench(const FrameBenchArgs& args) {
   if (args.suite != "tables" && args.suite != "rays" && args.suite != "grid" && args.suite != "stereo" &&
-      args.suite != "all")
-    throw Error("--suite must be tables, rays, grid, stereo or all, got '" + args.suite + "'");
+      args.suite != "foveation" && args.suite != "all")
+    throw Error("--suite must be tables, stereo, foveation, rays, grid or all, got '" + args.suite + "'");
   if (args.frames < 1 || args.frames > 100000) throw Error("--frames must be between 1 and 100000");
   if (args.warmup < 0 || args.warmup > 100000) throw Error("--warmup must be between 0 and 100000");
   if (args.k < 1 || args.k > kMaxKnn) throw Error("--k must be between 1 and " + std::to_string(kMaxKnn));
@@ -414,12 +500,13 @@ int runFrameBench(const FrameBenchArgs& args) {
                 (kind == BackendKind::Cpu ? std::string("--backend cpu was given") : why));
   nlohmann::json json = nlohmann::json::array();
   int failures = 0;
-  if (args.suite == "tables" || args.suite == "stereo" || args.suite == "all") {
+  if (args.suite == "tables" || args.suite == "stereo" || args.suite == "foveation" || args.suite == "all") {
     Scene scene = loadScene(args.scene);
     StereoRig rig = benchRig(scene, args);
     std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
-    if (args.suite != "stereo") failures += runTables(args, scene, *renderer, rig, json);
-    if (args.suite != "tables") failures += runStereo(args, *renderer, json);
+    if (args.suite == "tables" || args.suite == "all") failures += runTables(args, scene, *renderer, rig, json);
+    if (args.suite == "stereo" || args.suite == "all") failures += runStereo(args, *renderer, json);
+    if (args.suite == "foveation" || args.suite == "all") failures += runFoveation(args, scene, *renderer, rig, json);
   }
 #ifdef PVR_HAVE_CUDA
   if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json);

@@ -4,6 +4,7 @@
 
 #include "pvr/cuda/gpu_gather.cuh"
 #include "pvr/cuda/gpu_scene.cuh"
+#include "pvr/foveation/mask.h"
 
 namespace pvr {
 
@@ -29,7 +30,22 @@ struct CudaFrameRenderer::Impl {
   cuda::GpuHashGrid grid;
   cuda::GpuKdTree tree;
   cuda::GpuGather gather;
-  cuda::EventTimer traceTimer, buildTimer, scatterTimer;
+  cuda::EventTimer traceTimer, buildTimer, scatterTimer, reconstructTimer[2];
+  // The foveation mask last used (uploaded once; the frame's mask is compared by content size and address).
+  const FoveationMask* maskSource = nullptr;
+  size_t maskVertices = 0;
+  cuda::DeviceBuffer<MaskPoint> maskOffsets;
+  cuda::DeviceBuffer<uint32_t> maskTriangles;
+
+  cuda::DeviceMaskView uploadMask(const FoveationMask& mask) {
+    if (maskSource != &mask || maskVertices != mask.offsets.size()) {
+      maskOffsets.upload(mask.offsets.data(), mask.offsets.size(), "foveation mask vertices", stream);
+      maskTriangles.upload(mask.triangles.data(), mask.triangles.size(), "foveation mask triangles", stream);
+      maskSource = &mask;
+      maskVertices = mask.offsets.size();
+    }
+    return {maskOffsets.data(), maskTriangles.data(), uint32_t(mask.offsets.size()), uint32_t(mask.triangleCount())};
+  }
   cuda::EyeTimers eyeTimers[2];
   cudaDeviceProp properties{};
 
@@ -61,9 +77,12 @@ size_t CudaFrameRenderer::deviceBytes() const { return cuda::deviceBytesInUse();
 
 FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
   validateOptions(options, rig);
-  if (options.foveation.mask)
-    throw Error("foveated rendering runs on the CPU backend so far (--backend cpu); its CUDA raster kernel is not written yet");
   Impl& m = *impl_;
+  cuda::DeviceMaskView mask;
+  if (options.foveation.mask) {
+    checkMaskFits(*options.foveation.mask, rig.width, rig.height);
+    mask = m.uploadMask(*options.foveation.mask);
+  }
   FrameResult frame;
   PhotonTraceParams traceParams = options.photonTraceParams();
 
@@ -99,8 +118,14 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
       m.gather.scatter(m.deviceScene, rig, m.stream);
       m.scatterTimer.stop(m.stream);
     }
-    m.gather.renderEye(m.deviceScene, map, options, rig, Eye(e), m.stream, m.eyeTimers[e]);
+    if (options.foveation.mask)
+      m.gather.renderFoveatedEye(m.deviceScene, map, options, rig, Eye(e), mask, m.stream, m.eyeTimers[e],
+                                 m.reconstructTimer[e]);
+    else
+      m.gather.renderEye(m.deviceScene, map, options, rig, Eye(e), m.stream, m.eyeTimers[e]);
   }
+  uint32_t shadedVertices[2] = {0, 0};
+  if (options.foveation.mask) m.gather.downloadShadedVertices(shadedVertices, m.stream);
   if (options.stereo != StereoMode::Separate) m.gather.downloadReusedCount(&reused, m.stream);
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
   frame.reusedPixels = reused;
@@ -113,6 +138,11 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
     frame.timings.densityMs[e] = m.eyeTimers[e].densityMs();
     frame.timings.eyeMs[e] = frame.timings.eyeRayMs[e] + frame.timings.densityMs[e];
     frame.shadedSamples[e] = size_t(rig.width) * rig.height;
+    if (options.foveation.mask) {
+      frame.timings.reconstructMs[e] = m.reconstructTimer[e].ms();
+      frame.timings.eyeMs[e] += frame.timings.reconstructMs[e];
+      frame.shadedSamples[e] = shadedVertices[e];
+    }
   }
   frame.timings.eyeMs[1] += frame.timings.scatterMs;
   frame.deviceBytes = cuda::deviceBytesInUse();

@@ -239,6 +239,52 @@ __global__ void warpPerPointDensityKernel(HashGridView map, float radius, const 
   }
 }
 
+// Foveated rendering: the mask's vertices in use for a gaze (any triangle overlapping the image).
+__global__ void markUsedVerticesKernel(DeviceMaskView mask, int gazeX, int gazeY, int width, int height, uint8_t* used) {
+  uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
+  if (t >= mask.triangleCount) return;
+  MaskPoint v[3];
+  uint32_t index[3];
+  placeTriangle(mask.offsets, mask.triangles, t, gazeX, gazeY, v, index);
+  int x0, x1, y0, y1;
+  if (triangleBounds(v, width, height, x0, x1, y0, y1))
+    for (uint32_t i : index) used[i] = 1;  // every writer writes 1
+}
+
+struct VertexInUse {
+  const uint8_t* used;
+  __device__ bool operator()(uint32_t vertex) const { return used[vertex] != 0; }
+};
+
+// Eye rays through the listed vertices, to their gather points (indexed by vertex).
+__global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
+                                 Eye eye, DeviceMaskView mask, int gazeX, int gazeY, const uint32_t* list,
+                                 const uint32_t* listed, GatherPoint* points) {
+  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= *listed) return;
+  uint32_t vertex = list[i];
+  MaskPoint o = mask.offsets[vertex];
+  points[vertex] = imagePositionGatherPoint(scene, intersector, params, camera, eye, o.x + float(gazeX) + 0.5f,
+                                            o.y + float(gazeY) + 0.5f);
+}
+
+// One thread per listed gather point (kNN, or the kd-tree).
+template <class Map, Estimator E>
+__global__ void listedDensityKernel(Map map, DensityParams density, const GatherPoint* points, const uint32_t* list,
+                                    const uint32_t* listed, Vec3* colours) {
+  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= *listed) return;
+  density.estimator = E;
+  uint32_t vertex = list[i];
+  colours[vertex] = finishGather(map, points[vertex], density);
+}
+
+__global__ void rasterKernel(DeviceMaskView mask, int gazeX, int gazeY, const Vec3* colours, int width, int height,
+                             Vec3* image) {
+  uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
+  if (t < mask.triangleCount) rasterizeTriangle(mask.offsets, mask.triangles, t, gazeX, gazeY, colours, width, height, image);
+}
+
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
 __global__ void primaryRaysKernel(BvhIntersector intersector, EyeCamera camera, Hit* hits) {
   int x, y;
@@ -323,7 +369,8 @@ void dispatchSingle(const DeviceScene& scene, DeviceMap map, const GatherParams&
 
 size_t GpuGather::memoryBytes() const {
   size_t bytes = points_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
-                 reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes();
+                 reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
+                 vertexList_.bytes() + vertexCount_.bytes() + vertexPoints_.bytes() + vertexColours_.bytes();
   for (int i = 0; i < 2; ++i)
     bytes += images_[i].bytes() + firstPrim_[i].bytes() + sortKeys_[i].bytes() + sortValues_[i].bytes();
   return bytes;
@@ -459,6 +506,79 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
     }
     timers.density[s]->stop(stream);
   }
+}
+
+void GpuGather::downloadShadedVertices(uint32_t host[2], cudaStream_t stream) const {
+  PVR_CUDA_CHECK(cudaMemcpyAsync(host, vertexCount_.data(), 2 * sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
+}
+
+void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options,
+                                  const StereoRig& rig, Eye eye, const DeviceMaskView& mask, cudaStream_t stream,
+                                  EyeTimers& timers, EventTimer& reconstruct) {
+  const EyeCamera camera = rig.eye(eye);
+  const size_t pixels = size_t(camera.width) * camera.height;
+  const GatherParams& params = options.gather;
+  const bool knn = params.density.estimator == Estimator::Knn;
+  int gazeX, gazeY;
+  options.foveation.gazePixel(int(eye), camera.width, camera.height, gazeX, gazeY);
+  images_[int(eye)].reserve(pixels, "eye image");
+  firstPrim_[int(eye)].reserve(pixels, "first-hit ids");
+  vertexUsed_.reserve(mask.vertexCount, "mask vertices in use");
+  vertexList_.reserve(mask.vertexCount, "mask vertices to shade");
+  vertexCount_.reserve(2, "mask vertices shaded");
+  vertexPoints_.reserve(mask.vertexCount, "mask vertex gather points");
+  vertexColours_.reserve(mask.vertexCount, "mask vertex colours");
+  uint32_t* count = vertexCount_.data() + int(eye);
+  size_t bytes = 0;
+  thrust::counting_iterator<uint32_t> vertices(0);
+  PVR_CUDA_CHECK(cub::DeviceSelect::If(nullptr, bytes, vertices, vertexList_.data(), count, int(mask.vertexCount),
+                                       VertexInUse{vertexUsed_.data()}, stream));
+  temp_.reserve(bytes, "mask vertex selection scratch");
+  timers.prepare(1);
+
+  timers.rays[0]->start(stream);
+  PVR_CUDA_CHECK(cudaMemsetAsync(vertexUsed_.data(), 0, mask.vertexCount, stream));
+  markUsedVerticesKernel<<<blocksFor(mask.triangleCount, 256), 256, 0, stream>>>(mask, gazeX, gazeY, camera.width,
+                                                                               camera.height, vertexUsed_.data());
+  PVR_CUDA_CHECK_LAUNCH("markUsedVertices");
+  bytes = temp_.capacity();
+  PVR_CUDA_CHECK(cub::DeviceSelect::If(temp_.data(), bytes, vertices, vertexList_.data(), count, int(mask.vertexCount),
+                                       VertexInUse{vertexUsed_.data()}, stream));
+  vertexRaysKernel<<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(scene.view, scene.intersector, params, camera,
+                                                                         eye, mask, gazeX, gazeY, vertexList_.data(),
+                                                                         count, vertexPoints_.data());
+  PVR_CUDA_CHECK_LAUNCH("vertexRays");
+  timers.rays[0]->stop(stream);
+
+  timers.density[0]->start(stream);
+  if (map.grid && !knn) {  // the vertices are sparse in the image: one warp per point
+    int device = 0, sms = 0;
+    PVR_CUDA_CHECK(cudaGetDevice(&device));
+    PVR_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
+    warpPerPointDensityKernel<<<unsigned(sms) * 8u, 256, 0, stream>>>(*map.grid, params.density.radius,
+                                                                       vertexPoints_.data(), vertexList_.data(), count,
+                                                                       0, 1, vertexColours_.data());
+  } else if (map.grid) {
+    listedDensityKernel<HashGridView, Estimator::Knn><<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(
+        *map.grid, params.density, vertexPoints_.data(), vertexList_.data(), count, vertexColours_.data());
+  } else if (knn) {
+    listedDensityKernel<KdTreeView, Estimator::Knn><<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(
+        *map.tree, params.density, vertexPoints_.data(), vertexList_.data(), count, vertexColours_.data());
+  } else {
+    listedDensityKernel<KdTreeView, Estimator::Radius><<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(
+        *map.tree, params.density, vertexPoints_.data(), vertexList_.data(), count, vertexColours_.data());
+  }
+  PVR_CUDA_CHECK_LAUNCH("vertexDensity");
+  timers.density[0]->stop(stream);
+
+  reconstruct.start(stream);
+  PVR_CUDA_CHECK(cudaMemsetAsync(images_[int(eye)].data(), 0, pixels * sizeof(Vec3), stream));
+  rasterKernel<<<blocksFor(mask.triangleCount, 128), 128, 0, stream>>>(mask, gazeX, gazeY, vertexColours_.data(),
+                                                                       camera.width, camera.height,
+                                                                       images_[int(eye)].data());
+  PVR_CUDA_CHECK_LAUNCH("raster");
+  PVR_CUDA_CHECK(cudaMemsetAsync(firstPrim_[int(eye)].data(), 0xff, pixels * sizeof(uint32_t), stream));
+  reconstruct.stop(stream);
 }
 
 static double median(std::vector<double> v) {

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "pvr/cuda/gpu_scene.cuh"
+#include "pvr/foveation/reconstruct.h"
 #include "pvr/frame/frame.h"
 
 namespace pvr::cuda {
@@ -48,6 +49,13 @@ struct EyeOutputs {
   unsigned* reusedCount = nullptr;    ///< with reusedFrom: pixels that took the left eye's shading
 };
 
+// A foveation mask on the device.
+struct DeviceMaskView {
+  const MaskPoint* offsets = nullptr;
+  const uint32_t* triangles = nullptr;  ///< 3 per triangle
+  uint32_t vertexCount = 0, triangleCount = 0;
+};
+
 class GpuGather {
  public:
   // Shades one eye into image(eye) and firstPrim(eye); times its stages on `timers`. Under stereo
@@ -55,6 +63,13 @@ class GpuGather {
   // it (and after scatter() for Scatter), takes the left eye's shading where it may.
   void renderEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options, const StereoRig& rig,
                  Eye eye, cudaStream_t stream, EyeTimers& timers);
+  // Foveated: lists the mask's vertices in use for the eye's gaze, shades them (eye rays, then
+  // estimates) and rasterizes the eye's image from them (timed on `reconstruct`).
+  void renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options, const StereoRig& rig,
+                         Eye eye, const DeviceMaskView& mask, cudaStream_t stream, EyeTimers& timers,
+                         EventTimer& reconstruct);
+  // The number of vertices the last foveated pass of each eye shaded, copied when the stream gets there.
+  void downloadShadedVertices(uint32_t host[2], cudaStream_t stream) const;
   // Scatter: projects the left eye's recorded surfaces into the right image (after the left eye).
   void scatter(const DeviceScene& scene, const StereoRig& rig, cudaStream_t stream);
   const Vec3* image(Eye e) const { return images_[int(e)].data(); }
@@ -72,6 +87,10 @@ class GpuGather {
   DeviceBuffer<uint32_t> reusedFrom_;
   DeviceBuffer<unsigned> reusedCount_;
   DeviceBuffer<uint32_t> estimateList_, estimateCount_;  ///< the right eye's points still to estimate
+  DeviceBuffer<uint8_t> vertexUsed_;
+  DeviceBuffer<uint32_t> vertexList_, vertexCount_;  ///< foveated: the vertices shaded (count per eye)
+  DeviceBuffer<GatherPoint> vertexPoints_;
+  DeviceBuffer<Vec3> vertexColours_;
   DeviceBuffer<GatherPoint> points_;
   DeviceBuffer<uint32_t> sortKeys_[2], sortValues_[2];
   DeviceBuffer<unsigned char> temp_;

@@ -173,48 +173,15 @@ FoveationMask loadFoveationMask(const std::string& path) {
   return mask;
 }
 
-namespace {
-
-// Pixel bounds [x0, x1) x [y0, y1) of the centres a triangle may cover, clipped to the image.
-bool triangleBounds(const MaskPoint v[3], int width, int height, int& x0, int& x1, int& y0, int& y1) {
-  float minX = std::min({v[0].x, v[1].x, v[2].x}), maxX = std::max({v[0].x, v[1].x, v[2].x});
-  float minY = std::min({v[0].y, v[1].y, v[2].y}), maxY = std::max({v[0].y, v[1].y, v[2].y});
-  x0 = std::max(0, int(std::floor(minX - 0.5f)));
-  y0 = std::max(0, int(std::floor(minY - 0.5f)));
-  x1 = std::min(width, int(std::ceil(maxX - 0.5f)) + 1);
-  y1 = std::min(height, int(std::ceil(maxY - 0.5f)) + 1);
-  return x0 < x1 && y0 < y1;
-}
-
-void placedTriangle(const FoveationMask& mask, size_t t, int gazeX, int gazeY, MaskPoint v[3], uint32_t index[3]) {
-  for (int k = 0; k < 3; ++k) {
-    index[k] = mask.triangles[3 * t + k];
-    const MaskPoint& o = mask.offsets[index[k]];
-    v[k] = {o.x + float(gazeX) + 0.5f, o.y + float(gazeY) + 0.5f};
-  }
-}
-
-}  // namespace
-
 Image reconstructFoveatedImage(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours) {
   if (vertexColours.size() != mask.offsets.size()) throw Error("reconstruction needs one colour per mask vertex");
   const int w = mask.params.width, h = mask.params.height;
   Image image(w, h);
   // Each pixel centre belongs to one triangle: triangles write disjoint pixels, in parallel.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, mask.triangleCount(), 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t t = r.begin(); t < r.end(); ++t) {
-      MaskPoint v[3];
-      uint32_t index[3];
-      placedTriangle(mask, t, gazeX, gazeY, v, index);
-      int x0, x1, y0, y1;
-      if (!triangleBounds(v, w, h, x0, x1, y0, y1)) continue;
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
-          double weight[3];
-          if (coveredBy(v, index, x + 0.5, y + 0.5, weight))
-            image.at(x, y) = blend(weight, vertexColours[index[0]], vertexColours[index[1]], vertexColours[index[2]]);
-        }
-    }
+    for (size_t t = r.begin(); t < r.end(); ++t)
+      rasterizeTriangle(mask.offsets.data(), mask.triangles.data(), t, gazeX, gazeY, vertexColours.data(), w, h,
+                        image.pixels.data());
   });
   return image;
 }
@@ -232,7 +199,7 @@ std::vector<uint8_t> verticesInUse(const FoveationMask& mask, int gazeX, int gaz
   for (size_t t = 0; t < mask.triangleCount(); ++t) {
     MaskPoint v[3];
     uint32_t index[3];
-    placedTriangle(mask, t, gazeX, gazeY, v, index);
+    placeTriangle(mask.offsets.data(), mask.triangles.data(), t, gazeX, gazeY, v, index);
     int x0, x1, y0, y1;
     if (triangleBounds(v, mask.params.width, mask.params.height, x0, x1, y0, y1))
       for (uint32_t i : index) used[i] = 1;

@@ -53,10 +53,57 @@ PVR_HOST_DEVICE inline bool coveredBy(const MaskPoint v[3], const uint32_t index
   return true;
 }
 
+// Triangle t of a mask (offsets, 3 indices per triangle) placed with its origin at the centre of
+// pixel (gazeX, gazeY).
+PVR_HOST_DEVICE inline void placeTriangle(const MaskPoint* offsets, const uint32_t* triangles, size_t t, int gazeX,
+                                          int gazeY, MaskPoint v[3], uint32_t index[3]) {
+  for (int k = 0; k < 3; ++k) {
+    index[k] = triangles[3 * t + k];
+    v[k] = {offsets[index[k]].x + float(gazeX) + 0.5f, offsets[index[k]].y + float(gazeY) + 0.5f};
+  }
+}
+
+// Pixels [x0, x1) x [y0, y1) whose centres the triangle may cover, clipped to the image; false
+// if none.
+PVR_HOST_DEVICE inline bool triangleBounds(const MaskPoint v[3], int width, int height, int& x0, int& x1, int& y0,
+                                           int& y1) {
+  float minX = fminf(fminf(v[0].x, v[1].x), v[2].x), maxX = fmaxf(fmaxf(v[0].x, v[1].x), v[2].x);
+  float minY = fminf(fminf(v[0].y, v[1].y), v[2].y), maxY = fmaxf(fmaxf(v[0].y, v[1].y), v[2].y);
+  // Far outside: no pixel (and no int overflow below).
+  if (maxX < -1.0f || maxY < -1.0f || minX > float(width) + 1.0f || minY > float(height) + 1.0f) return false;
+  x0 = int(fmaxf(0.0f, floorf(minX - 0.5f)));
+  y0 = int(fmaxf(0.0f, floorf(minY - 0.5f)));
+  x1 = int(fminf(float(width), ceilf(maxX - 0.5f) + 1.0f));
+  y1 = int(fminf(float(height), ceilf(maxY - 0.5f) + 1.0f));
+  return x0 < x1 && y0 < y1;
+}
+
+// Writes the pixels of `image` (width x height) whose centres triangle t covers.
+PVR_HOST_DEVICE inline void rasterizeTriangle(const MaskPoint* offsets, const uint32_t* triangles, size_t t,
+                                              int gazeX, int gazeY, const Vec3* vertexColours, int width, int height,
+                                              Vec3* image);
+
 PVR_HOST_DEVICE inline Vec3 blend(const double weight[3], Vec3 c0, Vec3 c1, Vec3 c2) {
   return {float(weight[0] * c0.x + weight[1] * c1.x + weight[2] * c2.x),
           float(weight[0] * c0.y + weight[1] * c1.y + weight[2] * c2.y),
           float(weight[0] * c0.z + weight[1] * c1.z + weight[2] * c2.z)};
+}
+
+PVR_HOST_DEVICE inline void rasterizeTriangle(const MaskPoint* offsets, const uint32_t* triangles, size_t t,
+                                              int gazeX, int gazeY, const Vec3* vertexColours, int width, int height,
+                                              Vec3* image) {
+  MaskPoint v[3];
+  uint32_t index[3];
+  placeTriangle(offsets, triangles, t, gazeX, gazeY, v, index);
+  int x0, x1, y0, y1;
+  if (!triangleBounds(v, width, height, x0, x1, y0, y1)) return;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      double weight[3];
+      if (coveredBy(v, index, x + 0.5, y + 0.5, weight))
+        image[size_t(y) * width + x] =
+            blend(weight, vertexColours[index[0]], vertexColours[index[1]], vertexColours[index[2]]);
+    }
 }
 
 }  // namespace pvr

@@ -72,6 +72,8 @@ struct StageTimings {
   // Scatter's projection of the left hit points into the right image (visibility rays and
   // atomics), counted in the right eye's time.
   double scatterMs = 0;
+  // Foveated: the reconstruction of each eye's image from its mask vertices (in eyeMs).
+  double reconstructMs[2] = {0, 0};
   double totalMs() const { return photonTraceMs + mapBuildMs + eyeMs[0] + eyeMs[1]; }
 };
 

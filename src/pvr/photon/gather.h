@@ -120,20 +120,26 @@ PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeC
   return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 
-// The radiance seen through a continuous image position (a foveation mask's vertex), with the
+// The gather point seen through a continuous image position (a foveation mask's vertex), with the
 // random numbers of the pixel it lies in: a vertex on a pixel centre is shaded exactly as that
 // pixel's first sample. Positions outside the image get streams of their own.
-template <class Intersector, class PhotonMap>
-PVR_HOST_DEVICE Vec3 shadeImagePosition(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
-                                        const GatherParams& params, const EyeCamera& camera, Eye eye, float px,
-                                        float py) {
+template <class Intersector>
+PVR_HOST_DEVICE GatherPoint imagePositionGatherPoint(const SceneView& scene, const Intersector& intersector,
+                                                     const GatherParams& params, const EyeCamera& camera, Eye eye,
+                                                     float px, float py) {
   int ix = int(floorf(px)), iy = int(floorf(py));
   bool inside = ix >= 0 && iy >= 0 && ix < camera.width && iy < camera.height;
   uint32_t stream = inside ? uint32_t(iy) * uint32_t(camera.width) + uint32_t(ix)
                            : hashCombine(hashCombine(0x9e3779b9u, uint32_t(ix)), uint32_t(iy)) | 0x80000000u;
   CounterRng rng = pixelRng(params, eye, stream, 0);
-  Ray ray = camera.generateRay(px, py);
-  return finishGather(map, traceToDiffuse(scene, intersector, params, ray, rng), params.density);
+  return traceToDiffuse(scene, intersector, params, camera.generateRay(px, py), rng);
+}
+
+template <class Intersector, class PhotonMap>
+PVR_HOST_DEVICE Vec3 shadeImagePosition(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
+                                        const GatherParams& params, const EyeCamera& camera, Eye eye, float px,
+                                        float py) {
+  return finishGather(map, imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py), params.density);
 }
 
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
