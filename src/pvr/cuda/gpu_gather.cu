@@ -279,10 +279,15 @@ __global__ void listedDensityKernel(Map map, DensityParams density, const Gather
   colours[vertex] = finishGather(map, points[vertex], density);
 }
 
+// One warp per triangle, its lanes splitting the triangle's bounding box: the periphery's
+// triangles cover hundreds of pixels, the fovea's one, so a thread per triangle would leave the
+// GPU waiting on the few largest.
 __global__ void rasterKernel(DeviceMaskView mask, int gazeX, int gazeY, const Vec3* colours, int width, int height,
                              Vec3* image) {
-  uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
-  if (t < mask.triangleCount) rasterizeTriangle(mask.offsets, mask.triangles, t, gazeX, gazeY, colours, width, height, image);
+  uint32_t t = (blockIdx.x * blockDim.x + threadIdx.x) >> 5;
+  if (t < mask.triangleCount)
+    rasterizeTriangle(mask.offsets, mask.triangles, t, gazeX, gazeY, colours, width, height, image,
+                      int(threadIdx.x & 31u), 32);
 }
 
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
@@ -573,7 +578,7 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
 
   reconstruct.start(stream);
   PVR_CUDA_CHECK(cudaMemsetAsync(images_[int(eye)].data(), 0, pixels * sizeof(Vec3), stream));
-  rasterKernel<<<blocksFor(mask.triangleCount, 128), 128, 0, stream>>>(mask, gazeX, gazeY, vertexColours_.data(),
+  rasterKernel<<<blocksFor(size_t(mask.triangleCount) * 32, 256), 256, 0, stream>>>(mask, gazeX, gazeY, vertexColours_.data(),
                                                                        camera.width, camera.height,
                                                                        images_[int(eye)].data());
   PVR_CUDA_CHECK_LAUNCH("raster");

@@ -78,10 +78,11 @@ PVR_HOST_DEVICE inline bool triangleBounds(const MaskPoint v[3], int width, int 
   return x0 < x1 && y0 < y1;
 }
 
-// Writes the pixels of `image` (width x height) whose centres triangle t covers.
+// Writes the pixels of `image` (width x height) whose centres triangle t covers; the caller may
+// split the triangle's bounding box between `stride` workers (pixels first, first + stride, ...).
 PVR_HOST_DEVICE inline void rasterizeTriangle(const MaskPoint* offsets, const uint32_t* triangles, size_t t,
                                               int gazeX, int gazeY, const Vec3* vertexColours, int width, int height,
-                                              Vec3* image);
+                                              Vec3* image, int first = 0, int stride = 1);
 
 PVR_HOST_DEVICE inline Vec3 blend(const double weight[3], Vec3 c0, Vec3 c1, Vec3 c2) {
   return {float(weight[0] * c0.x + weight[1] * c1.x + weight[2] * c2.x),
@@ -91,19 +92,19 @@ PVR_HOST_DEVICE inline Vec3 blend(const double weight[3], Vec3 c0, Vec3 c1, Vec3
 
 PVR_HOST_DEVICE inline void rasterizeTriangle(const MaskPoint* offsets, const uint32_t* triangles, size_t t,
                                               int gazeX, int gazeY, const Vec3* vertexColours, int width, int height,
-                                              Vec3* image) {
+                                              Vec3* image, int first, int stride) {
   MaskPoint v[3];
   uint32_t index[3];
   placeTriangle(offsets, triangles, t, gazeX, gazeY, v, index);
   int x0, x1, y0, y1;
   if (!triangleBounds(v, width, height, x0, x1, y0, y1)) return;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) {
-      double weight[3];
-      if (coveredBy(v, index, x + 0.5, y + 0.5, weight))
-        image[size_t(y) * width + x] =
-            blend(weight, vertexColours[index[0]], vertexColours[index[1]], vertexColours[index[2]]);
-    }
+  const int boxWidth = x1 - x0, boxPixels = boxWidth * (y1 - y0);
+  for (int k = first; k < boxPixels; k += stride) {
+    int x = x0 + k % boxWidth, y = y0 + k / boxWidth;
+    double weight[3];
+    if (coveredBy(v, index, x + 0.5, y + 0.5, weight))
+      image[size_t(y) * width + x] = blend(weight, vertexColours[index[0]], vertexColours[index[1]], vertexColours[index[2]]);
+  }
 }
 
 }  // namespace pvr
