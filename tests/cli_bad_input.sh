@@ -55,6 +55,8 @@ expect_error "only for\|is for --foveated" render cornell --mask "$data/box.obj"
 expect_error "not implemented yet" render cornell --foveated --stereo gather --eye-size 16x16
 "$exe" mask --eye-size 32x32 --out "$out/m32.pvrmask" >/dev/null 2>&1
 expect_error "mask is for 32x32" render cornell --foveated --mask "$out/m32.pvrmask" --eye-size 16x16
+expect_error "cannot open trajectory" render cornell --trajectory "$data/missing.txt" --eye-size 8x8
+expect_error "line 2: .mtllib. is not a number" render cornell --trajectory "$data/box.obj" --eye-size 8x8
 expect_error "--suite must be" bench --suite speed
 expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1

@@ -11,6 +11,7 @@
 
 #include "frame_bench.h"
 #include "pvr/foveation/mask.h"
+#include "pvr/frame/trajectory.h"
 #include "map_bench.h"
 #include "pvr/render/image.h"
 #include "pvr/render/renderer.h"
@@ -75,6 +76,7 @@ struct RenderArgs {
   bool foveated = false;
   std::string mask;          // empty: made for the rig at start
   std::string gaze = "0.5,0.5";
+  std::string trajectory;    // one frame per line: head pose + gaze
   std::string out = "out/render";
   float exposure = 1.0f;
 };
@@ -186,6 +188,8 @@ int runRender(const RenderArgs& a) {
   } else if (!a.mask.empty()) {
     throw Error("--mask is for --foveated rendering");
   }
+  std::vector<TrajectoryFrame> trajectory;
+  if (!a.trajectory.empty()) trajectory = loadTrajectory(a.trajectory);
   ensureParentDirectory(a.out);  // before the work, not after it
   if (scene.skippedTriangles() > 0)
     std::cerr << "photonvr: warning: skipped " << scene.skippedTriangles()
@@ -199,10 +203,30 @@ int runRender(const RenderArgs& a) {
               options.gather.samplesPerPixel, options.gather.seed);
   std::printf("backend %s: %s%s\n", renderer->name().c_str(), renderer->deviceName().c_str(),
               renderer->name() == "cuda" ? (", " + std::string(densityKernelName(options.kernel)) + " kernel").c_str() : "");
+  const char* names[2] = {"left", "right"};
+  if (!trajectory.empty()) {  // one frame per pose, PREFIX_NNNN_left/right
+    double totalMs = 0;
+    for (size_t f = 0; f < trajectory.size(); ++f) {
+      rig.head = trajectory[f].head;
+      std::copy(&trajectory[f].gaze[0][0], &trajectory[f].gaze[0][0] + 4, &options.foveation.gaze[0][0]);
+      FrameResult frame = renderer->render(rig, options);
+      totalMs += frame.timings.totalMs();
+      char prefix[32];
+      std::snprintf(prefix, sizeof prefix, "_%04zu", f);
+      std::printf("frame %4zu: %8.2f ms (left eye %.2f, right eye %.2f), %zu + %zu samples shaded\n", f,
+                  frame.timings.totalMs(), frame.timings.eyeMs[0], frame.timings.eyeMs[1], frame.shadedSamples[0],
+                  frame.shadedSamples[1]);
+      for (int e = 0; e < 2; ++e)
+        if (options.eyes[e])
+          for (const char* ext : {".png", ".exr"}) writeImage(frame.eyes[e].image, a.out + prefix + "_" + names[e] + ext, a.exposure);
+    }
+    std::printf("%zu frames, %.2f ms per frame on average; wrote %s_NNNN_left/right.png/.exr\n", trajectory.size(),
+                totalMs / double(trajectory.size()), a.out.c_str());
+    return 0;
+  }
   FrameResult frame = renderer->render(rig, options);
   std::printf("  photon trace  %9.2f ms  (%zu photons stored)\n", frame.timings.photonTraceMs, frame.storedPhotons);
   std::printf("  map build     %9.2f ms  (%.1f MiB)\n", frame.timings.mapBuildMs, frame.mapBytes / 1048576.0);
-  const char* names[2] = {"left", "right"};
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;
     std::printf("  %-5s eye     %9.2f ms  (eye rays %.2f, density %.2f", names[e], frame.timings.eyeMs[e],
@@ -321,6 +345,9 @@ int runCli(int argc, char** argv) {
   render->add_option("--mask", ra.mask, "Foveation mask file from `photonvr mask` (default: made for the rig at start)");
   render->add_option("--gaze", ra.gaze, "Gaze point X,Y as fractions of the image (0.5,0.5 = centre)")
       ->capture_default_str();
+  render->add_option("--trajectory", ra.trajectory,
+                     "Render one frame per line of FILE: 'px py pz qx qy qz qw gx gy' (head pose; gaze as image "
+                     "fractions, used with --foveated), or 11 numbers with a gaze per eye; '#' comments");
   render->add_option("--out", ra.out, "Output prefix: writes PREFIX_left.png/.exr and PREFIX_right.png/.exr")
       ->capture_default_str();
 
