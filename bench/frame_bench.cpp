@@ -82,11 +82,7 @@ std::vector<Table> paperTables() {
 // The scene's rig, at --eye-size if given.
 StereoRig benchRig(const Scene& scene, const FrameBenchArgs& args) {
   StereoRig rig = scene.rig;
-  if (args.eyeSize.empty()) return rig;
-  int w = 0, h = 0;
-  if (std::sscanf(args.eyeSize.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-    throw Error("--eye-size must be WxH between 1x1 and 8192x8192, got '" + args.eyeSize + "'");
-  rig.width = w, rig.height = h;
+  if (!args.eyeSize.empty()) setEyeSize(rig, args.eyeSize);
   return rig;
 }
 
@@ -326,11 +322,7 @@ int runStereo(const FrameBenchArgs& args, FrameRenderer& renderer, nlohmann::jso
 // of eccentricity around the gaze (PSNR of the displayed image against the full-resolution one).
 int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& renderer, const StereoRig& rig,
                  nlohmann::json& json) {
-  MaskParams params;
-  params.width = rig.width, params.height = rig.height;
-  for (const Fov& f : rig.fov)
-    params.tanPerPixel = std::max({params.tanPerPixel, (std::tan(f.angleRight) - std::tan(f.angleLeft)) / float(rig.width),
-                                   (std::tan(f.angleUp) - std::tan(f.angleDown)) / float(rig.height)});
+  MaskParams params = maskParamsForRig(rig);
   FoveationMask linear = generateFoveationMask(params);
   params.acuity.kind = AcuityKind::GeislerPerry;
   FoveationMask geislerPerry = generateFoveationMask(params);

@@ -216,8 +216,8 @@ TEST(FoveatedRender, TheFoveaIsTheFullResolutionImageAndFewerSamplesAreShaded) {
   CpuBackend backend(scene);
   StereoRig rig = scene.rig;
   rig.width = 160, rig.height = 176;
-  MaskParams params = smallParams();
-  params.tanPerPixel = (std::tan(rig.fov[0].angleUp) - std::tan(rig.fov[0].angleDown)) / float(rig.height);
+  MaskParams params = maskParamsForRig(rig);
+  params.acuity = smallParams().acuity;
   FoveationMask mask = generateFoveationMask(params);
   RenderOptions o;
   o.photonsX = o.photonsY = 96;

@@ -186,10 +186,7 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
   Scene scene = builtinScene("cornell-caustics");
   StereoRig rig = scene.rig;
   rig.width = 320, rig.height = 352;
-  MaskParams params;
-  params.width = rig.width, params.height = rig.height;
-  params.tanPerPixel = (std::tan(rig.fov[0].angleUp) - std::tan(rig.fov[0].angleDown)) / float(rig.height);
-  FoveationMask mask = generateFoveationMask(params);
+  FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
   CpuFrameRenderer cpu(scene);
   CudaFrameRenderer gpu(scene);
   for (Estimator estimator : {Estimator::Radius, Estimator::Knn}) {

@@ -25,14 +25,14 @@ struct Size2 {
   long long x = 0, y = 0;
 };
 
-// "WxH" (also for photons: "256x256"), or a single number N for photon counts meaning N photons.
-Size2 parseSize(const std::string& text, const std::string& what, bool allowSingle) {
+// Emitted photons: "WxH" (the paper's 256x256), or a single number N meaning N photons.
+Size2 parsePhotonGrid(const std::string& text) {
   static const std::regex pair(R"(^\s*(\d{1,9})\s*[xX]\s*(\d{1,9})\s*$)");
   static const std::regex single(R"(^\s*(\d{1,12})\s*$)");
   std::smatch m;
   if (std::regex_match(text, m, pair)) return {std::stoll(m[1]), std::stoll(m[2])};
-  if (allowSingle && std::regex_match(text, m, single)) return {std::stoll(m[1]), 1};
-  throw Error(what + " must be WxH with positive integers, got '" + text + "'");
+  if (std::regex_match(text, m, single)) return {std::stoll(m[1]), 1};
+  throw Error("--photons must be WxH with positive integers, got '" + text + "'");
 }
 
 float parseFloat(const std::string& text, const std::string& what) {
@@ -106,7 +106,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
 
 RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   RenderOptions o;
-  Size2 photons = parseSize(a.photons, "--photons", true);
+  Size2 photons = parsePhotonGrid(a.photons);
   if (photons.x <= 0 || photons.y <= 0) throw Error("--photons must be positive, got '" + a.photons + "'");
   if (photons.x * photons.y > (1ll << 26)) throw Error("--photons is too large: at most 67108864 (8192x8192)");
   o.photonsX = uint32_t(photons.x);
@@ -132,13 +132,7 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   else if (a.eyes == "left") o.eyes[0] = true, o.eyes[1] = false;
   else if (a.eyes == "right") o.eyes[0] = false, o.eyes[1] = true;
   else throw Error("--eyes must be left, right or both, got '" + a.eyes + "'");
-  if (!a.eyeSize.empty()) {
-    Size2 s = parseSize(a.eyeSize, "--eye-size", false);
-    if (s.x < 1 || s.y < 1 || s.x > 8192 || s.y > 8192)
-      throw Error("--eye-size must be between 1x1 and 8192x8192, got '" + a.eyeSize + "'");
-    rig.width = int(s.x);
-    rig.height = int(s.y);
-  }
+  if (!a.eyeSize.empty()) setEyeSize(rig, a.eyeSize);
   if (!a.ipd.empty()) {
     float ipd = parseFloat(a.ipd, "--ipd");
     if (!(ipd >= 0.0f && ipd <= 1.0f)) throw Error("--ipd must be between 0 and 1 metre, got '" + a.ipd + "'");
@@ -157,17 +151,6 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   return o;
 }
 
-// The mask generator's parameters for a rig: the coarser of the two eyes' pixels at the optical
-// centre, so that the mask never has fewer samples than either eye needs.
-MaskParams maskParamsFor(const StereoRig& rig) {
-  MaskParams params;
-  params.width = rig.width, params.height = rig.height;
-  for (const Fov& f : rig.fov)
-    params.tanPerPixel = std::max({params.tanPerPixel, (std::tan(f.angleRight) - std::tan(f.angleLeft)) / float(rig.width),
-                                   (std::tan(f.angleUp) - std::tan(f.angleDown)) / float(rig.height)});
-  return params;
-}
-
 int runRender(const RenderArgs& a) {
   BackendKind backendKind = parseBackendKind(a.backend);
   Scene scene = loadScene(a.scene);
@@ -180,7 +163,7 @@ int runRender(const RenderArgs& a) {
     if (std::sscanf(a.gaze.c_str(), "%f,%f%c", &gx, &gy, &extra) != 2 || !(gx >= 0.0f && gx <= 1.0f) ||
         !(gy >= 0.0f && gy <= 1.0f))
       throw Error("--gaze must be X,Y with both in [0, 1] (image fractions, 0.5,0.5 = centre), got '" + a.gaze + "'");
-    mask = a.mask.empty() ? generateFoveationMask(maskParamsFor(rig)) : loadFoveationMask(a.mask);
+    mask = a.mask.empty() ? generateFoveationMask(maskParamsForRig(rig)) : loadFoveationMask(a.mask);
     checkMaskFits(mask, rig.width, rig.height);
     options.foveation.mask = &mask;
     for (auto& g : options.foveation.gaze) g[0] = gx, g[1] = gy;
@@ -281,13 +264,8 @@ struct MaskArgs {
 int runMask(const MaskArgs& a) {
   Scene scene = loadScene(a.scene);
   StereoRig rig = scene.rig;
-  if (!a.eyeSize.empty()) {
-    Size2 s = parseSize(a.eyeSize, "--eye-size", false);
-    if (s.x < 1 || s.y < 1 || s.x > 8192 || s.y > 8192)
-      throw Error("--eye-size must be between 1x1 and 8192x8192, got '" + a.eyeSize + "'");
-    rig.width = int(s.x), rig.height = int(s.y);
-  }
-  MaskParams params = maskParamsFor(rig);
+  if (!a.eyeSize.empty()) setEyeSize(rig, a.eyeSize);
+  MaskParams params = maskParamsForRig(rig);
   if (a.acuity == "linear") params.acuity.kind = AcuityKind::LinearMar;
   else if (a.acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
   else throw Error("--acuity must be linear or geisler-perry, got '" + a.acuity + "'");

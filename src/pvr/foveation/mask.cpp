@@ -49,6 +49,15 @@ T get(std::ifstream& in, const std::string& path) {
 
 }  // namespace
 
+MaskParams maskParamsForRig(const StereoRig& rig) {
+  MaskParams params;
+  params.width = rig.width, params.height = rig.height;
+  for (const Fov& f : rig.fov)
+    params.tanPerPixel = std::max({params.tanPerPixel, (std::tan(f.angleRight) - std::tan(f.angleLeft)) / float(rig.width),
+                                   (std::tan(f.angleUp) - std::tan(f.angleDown)) / float(rig.height)});
+  return params;
+}
+
 double eccentricityDeg(double radiusPixels, double tanPerPixel) {
   return std::atan(radiusPixels * tanPerPixel) * kDegPerRad;
 }

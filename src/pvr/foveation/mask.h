@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "pvr/camera/stereo_rig.h"
 #include "pvr/foveation/acuity.h"
 #include "pvr/foveation/reconstruct.h"
 #include "pvr/frame/image.h"
@@ -18,6 +19,10 @@ struct MaskParams {
   float tanPerPixel = 0.0f;         ///< image-plane size of a pixel at the optical centre (tan units)
   AcuityModel acuity;
 };
+
+// Parameters (default acuity) for a headset rig: its eye size, and the coarser of the two eyes'
+// pixels at the optical centre, so that the mask never has fewer samples than either eye needs.
+MaskParams maskParamsForRig(const StereoRig& rig);
 
 struct FoveationMask {
   MaskParams params;

@@ -1,6 +1,7 @@
 #include "pvr/frame/frame.h"
 
 #include <cmath>
+#include <regex>
 #include <string>
 
 #include "pvr/util/error.h"
@@ -33,6 +34,17 @@ StereoMode parseStereoMode(const std::string& text, const std::string& what) {
   for (StereoMode m : {StereoMode::Separate, StereoMode::Scatter, StereoMode::Gather})
     if (text == stereoModeName(m)) return m;
   throw Error(what + " must be separate, scatter or gather, got '" + text + "'");
+}
+
+void setEyeSize(StereoRig& rig, const std::string& text) {
+  static const std::regex size(R"(^\s*(\d{1,9})\s*[xX]\s*(\d{1,9})\s*$)");
+  std::smatch m;
+  long long w = 0, h = 0;
+  if (std::regex_match(text, m, size)) w = std::stoll(m[1]), h = std::stoll(m[2]);
+  if (w < 1 || h < 1 || w > kMaxEyeDimension || h > kMaxEyeDimension)
+    throw Error("--eye-size must be WxH between 1x1 and " + std::to_string(kMaxEyeDimension) + "x" +
+                std::to_string(kMaxEyeDimension) + ", got '" + text + "'");
+  rig.width = int(w), rig.height = int(h);
 }
 
 void validateOptions(const RenderOptions& o, const StereoRig& rig) {

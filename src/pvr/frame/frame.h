@@ -95,6 +95,10 @@ struct FrameResult {
   size_t shadedSamples[2] = {0, 0};  ///< per eye: pixels, or mask vertices when foveated
 };
 
+// Sets the rig's per-eye resolution from "WxH" (1x1 .. 8192x8192); throws pvr::Error naming
+// --eye-size otherwise.
+void setEyeSize(StereoRig& rig, const std::string& text);
+
 // Checks options against the rig; throws pvr::Error naming the bad value.
 void validateOptions(const RenderOptions& options, const StereoRig& rig);
 
