@@ -84,13 +84,11 @@ Image CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const Gath
   return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, shaded);
 }
 
-size_t CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target,
+void CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target,
                            uint64_t* scattered) const {
   SceneView view = scene_.view();
   std::fill(scattered, scattered + size_t(target.width) * target.height, kNothingScattered);
-  std::atomic<size_t> written{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, sourcePixels, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    size_t count = 0;
     for (size_t i = r.begin(); i < r.end(); ++i) {
       uint32_t pixel;
       uint64_t entry;
@@ -99,11 +97,8 @@ size_t CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, con
       uint64_t current = slot.load(std::memory_order_relaxed);
       while (entry < current && !slot.compare_exchange_weak(current, entry, std::memory_order_relaxed)) {
       }
-      ++count;
     }
-    written += count;
   });
-  return written;
 }
 
 }  // namespace pvr

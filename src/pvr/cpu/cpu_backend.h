@@ -38,8 +38,8 @@ class CpuBackend {
 
   // Scatter: projects every reusable source pixel's surface into `target`'s image, keeping the
   // nearest per target pixel in `scattered` (width * height entries, filled with kNothingScattered
-  // here). Returns the number of source points written.
-  size_t scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target, uint64_t* scattered) const;
+  // here).
+  void scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target, uint64_t* scattered) const;
 
   const Scene& scene() const { return scene_; }
   const EmbreeIntersector& intersector() const { return intersector_; }

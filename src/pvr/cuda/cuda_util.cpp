@@ -65,4 +65,11 @@ void deviceFree(void* p, size_t bytes) {
   gBytesInUse -= bytes == 0 ? 1 : bytes;
 }
 
+int multiprocessorCount() {
+  int device = 0, count = 0;
+  PVR_CUDA_CHECK(cudaGetDevice(&device));
+  PVR_CUDA_CHECK(cudaDeviceGetAttribute(&count, cudaDevAttrMultiProcessorCount, device));
+  return count;
+}
+
 }  // namespace pvr::cuda

@@ -110,6 +110,9 @@ inline int radixBitsFor(uint64_t values) {
   return bits;
 }
 
+// Streaming multiprocessors of the current device (for grid-stride launches that fill the GPU).
+int multiprocessorCount();
+
 inline unsigned blocksFor(size_t n, unsigned threads) { return unsigned((n + threads - 1) / threads); }
 
 }  // namespace pvr::cuda

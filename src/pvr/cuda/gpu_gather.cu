@@ -477,10 +477,7 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
       storeWithoutEstimateKernel<<<blocksFor(pixels, 256), 256, 0, stream>>>(points_.data(), uint32_t(pixels), s,
                                                                             params.samplesPerPixel, image);
       PVR_CUDA_CHECK_LAUNCH("storeWithoutEstimate");
-      int device = 0, sms = 0;
-      PVR_CUDA_CHECK(cudaGetDevice(&device));
-      PVR_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
-      warpPerPointDensityKernel<<<unsigned(sms) * 8u, 256, 0, stream>>>(*map.grid, params.density.radius, points_.data(),
+      warpPerPointDensityKernel<<<unsigned(multiprocessorCount()) * 8u, 256, 0, stream>>>(*map.grid, params.density.radius, points_.data(),
                                                                          estimateList_.data(), estimateCount_.data(), s,
                                                                          params.samplesPerPixel, image);
       PVR_CUDA_CHECK_LAUNCH("warpPerPointDensity");
@@ -557,10 +554,7 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
 
   timers.density[0]->start(stream);
   if (map.grid && !knn) {  // the vertices are sparse in the image: one warp per point
-    int device = 0, sms = 0;
-    PVR_CUDA_CHECK(cudaGetDevice(&device));
-    PVR_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
-    warpPerPointDensityKernel<<<unsigned(sms) * 8u, 256, 0, stream>>>(*map.grid, params.density.radius,
+    warpPerPointDensityKernel<<<unsigned(multiprocessorCount()) * 8u, 256, 0, stream>>>(*map.grid, params.density.radius,
                                                                        vertexPoints_.data(), vertexList_.data(), count,
                                                                        0, 1, vertexColours_.data());
   } else if (map.grid) {

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 
 #include "pvr/cuda/gpu_scene.cuh"
 
@@ -12,23 +11,11 @@ namespace {
 
 // Floats as ints whose order is the floats' order, for atomicMin/atomicMax on bounds.
 PVR_HOST_DEVICE inline int orderedFromFloat(float f) {
-  int i;
-#ifdef __CUDA_ARCH__
-  i = __float_as_int(f);
-#else
-  std::memcpy(&i, &f, 4);
-#endif
+  int i = int(floatBits(f));
   return i >= 0 ? i : i ^ 0x7FFFFFFF;
 }
 PVR_HOST_DEVICE inline float floatFromOrdered(int i) {
-  int bits = i >= 0 ? i : i ^ 0x7FFFFFFF;
-  float f;
-#ifdef __CUDA_ARCH__
-  f = __int_as_float(bits);
-#else
-  std::memcpy(&f, &bits, 4);
-#endif
-  return f;
+  return floatFromBits(uint32_t(i >= 0 ? i : i ^ 0x7FFFFFFF));
 }
 
 __global__ void tracePhotonsKernel(SceneView scene, BvhIntersector intersector, PhotonTraceParams params,

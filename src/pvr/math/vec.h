@@ -1,10 +1,32 @@
 #pragma once
 // Small vector types shared by host and device code.
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "pvr/pvr.h"
 
 namespace pvr {
+
+// A float's bits and back (for order-preserving keys and atomics on floats).
+PVR_HOST_DEVICE inline uint32_t floatBits(float f) {
+#ifdef __CUDA_ARCH__
+  return __float_as_uint(f);
+#else
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  return bits;
+#endif
+}
+PVR_HOST_DEVICE inline float floatFromBits(uint32_t bits) {
+#ifdef __CUDA_ARCH__
+  return __uint_as_float(bits);
+#else
+  float f;
+  std::memcpy(&f, &bits, sizeof f);
+  return f;
+#endif
+}
 
 struct Vec2 {
   float x = 0, y = 0;

@@ -20,8 +20,6 @@
 //    tessellated surface: with triangles of a pixel or less, the same-triangle test alone would
 //    reuse little), seen from the same side, within the pixel's footprint along the surface and
 //    a tenth of it off the surface. No holes, no visibility rays.
-#include <cstring>
-
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/shading/scene_view.h"
 
@@ -81,16 +79,6 @@ struct StereoReuseView {
 
   PVR_HOST_DEVICE bool reusing() const { return mode != StereoMode::Separate; }
 };
-
-PVR_HOST_DEVICE inline uint32_t floatBits(float f) {
-#ifdef __CUDA_ARCH__
-  return __float_as_uint(f);
-#else
-  uint32_t bits;
-  std::memcpy(&bits, &f, sizeof bits);
-  return bits;
-#endif
-}
 
 // Scatter's buffer entry: the distance to the target eye in the high word (a non-negative float's
 // bits order like the float), so the atomic minimum keeps the nearest point; the left pixel in
