@@ -51,7 +51,30 @@ struct EyeCamera {
   // Continuous pixel position of a world point; returns false if the point is behind the eye.
   // The pixel may lie outside [0,width)x[0,height): callers check containsPixel.
   PVR_HOST_DEVICE bool project(Vec3 world, float& px, float& py) const {
-    Vec3 v = pose.toLocalPoint(world);
+    return projectLocal(pose.toLocalPoint(world), px, py);
+  }
+  // Continuous pixel position of the point at infinity in direction `worldDir`.
+  PVR_HOST_DEVICE bool projectDirection(Vec3 worldDir, float& px, float& py) const {
+    return projectLocal(pose.orientation.conjugate().rotate(worldDir), px, py);
+  }
+
+  // 1 / z of a world point, z its distance along the view axis; 0 for points not in front.
+  // Inverse depth is affine in pixel space across a plane, so it interpolates exactly.
+  PVR_HOST_DEVICE float inverseDepthOf(Vec3 world) const {
+    float z = -pose.toLocalPoint(world).z;
+    return z > 0.0f ? 1.0f / z : 0.0f;
+  }
+  // The world point seen through pixel-space (px, py) at inverse depth w > 0.
+  PVR_HOST_DEVICE Vec3 pointAt(float px, float py, float inverseDepth) const {
+    return pose.toWorldPoint(localDirection(px, py) * (1.0f / inverseDepth));
+  }
+
+  PVR_HOST_DEVICE bool containsPixel(float px, float py) const {
+    return px >= 0.0f && py >= 0.0f && px < float(width) && py < float(height);
+  }
+
+ private:
+  PVR_HOST_DEVICE bool projectLocal(Vec3 v, float& px, float& py) const {
     if (!(v.z < 0.0f)) return false;
     float x = v.x / -v.z, y = v.y / -v.z;
     float tl = tanf(fov.angleLeft), tr = tanf(fov.angleRight);
@@ -59,10 +82,6 @@ struct EyeCamera {
     px = (x - tl) / (tr - tl) * float(width);
     py = (tu - y) / (tu - td) * float(height);
     return true;
-  }
-
-  PVR_HOST_DEVICE bool containsPixel(float px, float py) const {
-    return px >= 0.0f && py >= 0.0f && px < float(width) && py < float(height);
   }
 };
 

@@ -54,34 +54,38 @@ void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams&
 }
 
 template <class Map>
-Image CpuBackend::renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                                        const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const {
+size_t CpuBackend::renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                                         const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const {
   SceneView view = scene_.view();
   std::vector<uint8_t> used = verticesInUse(mask, gazeX, gazeY);
   std::vector<uint32_t> vertices;
   for (uint32_t i = 0; i < used.size(); ++i)
     if (used[i]) vertices.push_back(i);
-  shaded = vertices.size();
   std::vector<Vec3> colours(mask.offsets.size());
+  std::vector<float> inverseDepths(mask.offsets.size(), 0.0f);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k < r.end(); ++k) {
-      const MaskPoint& o = mask.offsets[vertices[k]];
-      colours[vertices[k]] = shadeImagePosition(view, intersector_, map, params, camera, eye,
-                                                o.x + float(gazeX) + 0.5f, o.y + float(gazeY) + 0.5f);
+      const uint32_t v = vertices[k];
+      const MaskPoint& o = mask.offsets[v];
+      GatherPoint point = imagePositionGatherPoint(view, intersector_, params, camera, eye, o.x + float(gazeX) + 0.5f,
+                                                   o.y + float(gazeY) + 0.5f, &inverseDepths[v]);
+      colours[v] = finishGather(map, point, params.density);
     }
   });
-  return reconstructFoveatedImage(mask, gazeX, gazeY, colours);
+  reconstructFoveatedEye(mask, gazeX, gazeY, colours, inverseDepths, out);
+  out.firstPrim.clear();
+  return vertices.size();
 }
 
-Image CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params,
-                                    const HashGridView& map, const FoveationMask& mask, int gazeX, int gazeY,
-                                    size_t& shaded) const {
-  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, shaded);
+size_t CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params,
+                                     const HashGridView& map, const FoveationMask& mask, int gazeX, int gazeY,
+                                     EyeResult& out) const {
+  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out);
 }
 
-Image CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                                    const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const {
-  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, shaded);
+size_t CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                                     const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const {
+  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out);
 }
 
 void CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target,

@@ -30,11 +30,11 @@ class CpuBackend {
                  SurfaceRecord* surfaces = nullptr) const;
 
   // Foveated: shades the mask's vertices in use for the gaze pixel (gazeX, gazeY) and reconstructs
-  // the eye's image from them; `shaded` is the number of vertices shaded.
-  Image renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
-                          const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const;
-  Image renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                          const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const;
+  // the eye's image, depth and sample spacing from them into `out`; returns the vertices shaded.
+  size_t renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
+                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const;
+  size_t renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const;
 
   // Scatter: projects every reusable source pixel's surface into `target`'s image, keeping the
   // nearest per target pixel in `scattered` (width * height entries, filled with kNothingScattered
@@ -46,8 +46,8 @@ class CpuBackend {
 
  private:
   template <class Map>
-  Image renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                              const FoveationMask& mask, int gazeX, int gazeY, size_t& shaded) const;
+  size_t renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                               const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const;
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
                      PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const;

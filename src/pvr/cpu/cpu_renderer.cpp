@@ -56,12 +56,10 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
       options.foveation.gazePixel(e, rig.width, rig.height, gx, gy);
       start = std::chrono::steady_clock::now();
       EyeCamera camera = rig.eye(Eye(e));
-      if (options.map == PhotonMapKind::HashGrid)
-        frame.eyes[e].image = backend.renderFoveatedEye(camera, Eye(e), options.gather, grid.view(), *mask, gx, gy,
-                                                        frame.shadedSamples[e]);
-      else
-        frame.eyes[e].image = backend.renderFoveatedEye(camera, Eye(e), options.gather, tree.view(), *mask, gx, gy,
-                                                        frame.shadedSamples[e]);
+      frame.shadedSamples[e] =
+          options.map == PhotonMapKind::HashGrid
+              ? backend.renderFoveatedEye(camera, Eye(e), options.gather, grid.view(), *mask, gx, gy, frame.eyes[e])
+              : backend.renderFoveatedEye(camera, Eye(e), options.gather, tree.view(), *mask, gx, gy, frame.eyes[e]);
       frame.timings.eyeMs[e] = frame.timings.eyeRayMs[e] = msSince(start);
     }
     return frame;
@@ -103,9 +101,11 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
     frame.shadedSamples[e] = samples.size();
     out.image = Image(camera.width, camera.height);
     out.firstPrim.resize(samples.size());
+    out.inverseDepth.resize(samples.size());
     for (size_t i = 0; i < samples.size(); ++i) {
       out.image.pixels[i] = samples[i].radiance;
       out.firstPrim[i] = samples[i].firstPrim;
+      out.inverseDepth[i] = samples[i].inverseDepth;
     }
     if (reuse.reusing()) {
       out.reusedFrom.resize(samples.size());
@@ -114,6 +114,22 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
         frame.reusedPixels += out.reusedFrom[i] != kNotReused ? 1 : 0;
       }
     }
+  }
+  return frame;
+}
+
+FrameResult CpuFrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
+  FrameResult frame = renderFrame(backend_, rig, options);
+  for (int e = 0; e < 2; ++e) {
+    if (!options.eyes[e]) continue;
+    if (!options.temporal.enabled) {
+      history_[e].valid = false;
+      continue;
+    }
+    auto start = std::chrono::steady_clock::now();
+    frame.historyPixels[e] = resolveTemporal(rig.eye(Eye(e)), options.temporal.taa, frame.eyes[e], history_[e]);
+    frame.timings.temporalMs[e] = msSince(start);
+    frame.timings.eyeMs[e] += frame.timings.temporalMs[e];
   }
   return frame;
 }

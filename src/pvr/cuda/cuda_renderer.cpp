@@ -4,6 +4,7 @@
 
 #include "pvr/cuda/gpu_gather.cuh"
 #include "pvr/cuda/gpu_scene.cuh"
+#include "pvr/cuda/gpu_temporal.cuh"
 #include "pvr/foveation/mask.h"
 
 namespace pvr {
@@ -30,7 +31,8 @@ struct CudaFrameRenderer::Impl {
   cuda::GpuHashGrid grid;
   cuda::GpuKdTree tree;
   cuda::GpuGather gather;
-  cuda::EventTimer traceTimer, buildTimer, scatterTimer, reconstructTimer[2];
+  cuda::GpuTemporal temporal;
+  cuda::EventTimer traceTimer, buildTimer, scatterTimer, reconstructTimer[2], temporalTimer[2];
   // The foveation mask last used (uploaded once; the frame's mask is compared by content size and address).
   const FoveationMask* maskSource = nullptr;
   size_t maskVertices = 0;
@@ -123,9 +125,20 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
                                  m.reconstructTimer[e]);
     else
       m.gather.renderEye(m.deviceScene, map, options, rig, Eye(e), m.stream, m.eyeTimers[e]);
+    if (!options.temporal.enabled) {
+      m.temporal.forget(Eye(e));
+      continue;
+    }
+    m.temporalTimer[e].start(m.stream);
+    m.temporal.resolve(Eye(e), rig.eye(Eye(e)), options.temporal.taa, m.gather.image(Eye(e)),
+                       m.gather.inverseDepth(Eye(e)), options.foveation.mask ? m.gather.sampleSpacing(Eye(e)) : nullptr,
+                       m.stream);
+    m.temporalTimer[e].stop(m.stream);
   }
   uint32_t shadedVertices[2] = {0, 0};
+  unsigned historyPixels[2] = {0, 0};
   if (options.foveation.mask) m.gather.downloadShadedVertices(shadedVertices, m.stream);
+  if (options.temporal.enabled) m.temporal.downloadHistoryPixels(historyPixels, m.stream);
   if (options.stereo != StereoMode::Separate) m.gather.downloadReusedCount(&reused, m.stream);
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
   frame.reusedPixels = reused;
@@ -143,6 +156,11 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
       frame.timings.eyeMs[e] += frame.timings.reconstructMs[e];
       frame.shadedSamples[e] = shadedVertices[e];
     }
+    if (options.temporal.enabled) {
+      frame.timings.temporalMs[e] = m.temporalTimer[e].ms();
+      frame.timings.eyeMs[e] += frame.timings.temporalMs[e];
+      frame.historyPixels[e] = historyPixels[e];
+    }
   }
   frame.timings.eyeMs[1] += frame.timings.scatterMs;
   frame.deviceBytes = cuda::deviceBytesInUse();
@@ -151,14 +169,24 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
     for (int e = 0; e < 2; ++e) {
       if (!options.eyes[e]) continue;
       EyeResult& out = frame.eyes[e];
+      const size_t pixels = size_t(rig.width) * rig.height;
       out.image = Image(rig.width, rig.height);
-      out.firstPrim.resize(size_t(rig.width) * rig.height);
-      PVR_CUDA_CHECK(cudaMemcpyAsync(out.image.pixels.data(), m.gather.image(Eye(e)), out.image.pixels.size() * sizeof(Vec3),
+      const Vec3* shown = options.temporal.enabled ? m.temporal.image(Eye(e)) : m.gather.image(Eye(e));
+      PVR_CUDA_CHECK(cudaMemcpyAsync(out.image.pixels.data(), shown, pixels * sizeof(Vec3), cudaMemcpyDeviceToHost, m.stream));
+      out.inverseDepth.resize(pixels);
+      PVR_CUDA_CHECK(cudaMemcpyAsync(out.inverseDepth.data(), m.gather.inverseDepth(Eye(e)), pixels * sizeof(float),
                                      cudaMemcpyDeviceToHost, m.stream));
-      PVR_CUDA_CHECK(cudaMemcpyAsync(out.firstPrim.data(), m.gather.firstPrim(Eye(e)), out.firstPrim.size() * sizeof(uint32_t),
-                                     cudaMemcpyDeviceToHost, m.stream));
+      if (options.foveation.mask) {
+        out.sampleSpacing.resize(pixels);
+        PVR_CUDA_CHECK(cudaMemcpyAsync(out.sampleSpacing.data(), m.gather.sampleSpacing(Eye(e)), pixels * sizeof(float),
+                                       cudaMemcpyDeviceToHost, m.stream));
+      } else {
+        out.firstPrim.resize(pixels);
+        PVR_CUDA_CHECK(cudaMemcpyAsync(out.firstPrim.data(), m.gather.firstPrim(Eye(e)), pixels * sizeof(uint32_t),
+                                       cudaMemcpyDeviceToHost, m.stream));
+      }
       if (e == 1 && options.stereo != StereoMode::Separate) {
-        out.reusedFrom.resize(out.firstPrim.size());
+        out.reusedFrom.resize(pixels);
         PVR_CUDA_CHECK(cudaMemcpyAsync(out.reusedFrom.data(), m.gather.reusedFrom(), out.reusedFrom.size() * sizeof(uint32_t),
                                        cudaMemcpyDeviceToHost, m.stream));
       }
@@ -166,6 +194,10 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
     PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
   }
   return frame;
+}
+
+void CudaFrameRenderer::resetHistory() {
+  for (Eye e : {Eye::Left, Eye::Right}) impl_->temporal.forget(e);
 }
 
 std::vector<Photon> CudaFrameRenderer::tracePhotons(const PhotonTraceParams& params) {

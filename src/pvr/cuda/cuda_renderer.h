@@ -33,6 +33,7 @@ class CudaFrameRenderer : public FrameRenderer {
   explicit CudaFrameRenderer(const Scene& scene);
   ~CudaFrameRenderer() override;
   FrameResult render(const StereoRig& rig, const RenderOptions& options, bool images = true) override;
+  void resetHistory() override;
   std::string name() const override { return "cuda"; }
   std::string deviceName() const override;
 

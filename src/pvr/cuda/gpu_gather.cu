@@ -31,6 +31,7 @@ __device__ inline void storeSample(Vec3* image, size_t pixel, Vec3 c, int sample
 // per warp: one atomic per warp, not per pixel).
 __device__ inline void recordPixel(const EyeOutputs& out, size_t pixel, const PixelSample& p) {
   out.firstPrim[pixel] = p.firstPrim;
+  out.inverseDepth[pixel] = p.inverseDepth;
   if (!out.reusedFrom) return;
   out.reusedFrom[pixel] = p.reusedFrom;
   unsigned active = __activemask();
@@ -259,13 +260,15 @@ struct VertexInUse {
 // Eye rays through the listed vertices, to their gather points (indexed by vertex).
 __global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
                                  Eye eye, DeviceMaskView mask, int gazeX, int gazeY, const uint32_t* list,
-                                 const uint32_t* listed, GatherPoint* points) {
+                                 const uint32_t* listed, GatherPoint* points, float* inverseDepths) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= *listed) return;
   uint32_t vertex = list[i];
   MaskPoint o = mask.offsets[vertex];
+  float inverseDepth;
   points[vertex] = imagePositionGatherPoint(scene, intersector, params, camera, eye, o.x + float(gazeX) + 0.5f,
-                                            o.y + float(gazeY) + 0.5f);
+                                            o.y + float(gazeY) + 0.5f, &inverseDepth);
+  inverseDepths[vertex] = inverseDepth;
 }
 
 // One thread per listed gather point (kNN, or the kd-tree).
@@ -282,12 +285,10 @@ __global__ void listedDensityKernel(Map map, DensityParams density, const Gather
 // One warp per triangle, its lanes splitting the triangle's bounding box: the periphery's
 // triangles cover hundreds of pixels, the fovea's one, so a thread per triangle would leave the
 // GPU waiting on the few largest.
-__global__ void rasterKernel(DeviceMaskView mask, int gazeX, int gazeY, const Vec3* colours, int width, int height,
-                             Vec3* image) {
+__global__ void rasterKernel(DeviceMaskView mask, int gazeX, int gazeY, VertexValues vertices, RasterTarget target) {
   uint32_t t = (blockIdx.x * blockDim.x + threadIdx.x) >> 5;
   if (t < mask.triangleCount)
-    rasterizeTriangle(mask.offsets, mask.triangles, t, gazeX, gazeY, colours, width, height, image,
-                      int(threadIdx.x & 31u), 32);
+    rasterizeTriangle(mask.offsets, mask.triangles, t, gazeX, gazeY, vertices, target, int(threadIdx.x & 31u), 32);
 }
 
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
@@ -375,9 +376,11 @@ void dispatchSingle(const DeviceScene& scene, DeviceMap map, const GatherParams&
 size_t GpuGather::memoryBytes() const {
   size_t bytes = points_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
                  reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
-                 vertexList_.bytes() + vertexCount_.bytes() + vertexPoints_.bytes() + vertexColours_.bytes();
+                 vertexList_.bytes() + vertexCount_.bytes() + vertexPoints_.bytes() + vertexColours_.bytes() +
+                 vertexInverseDepths_.bytes();
   for (int i = 0; i < 2; ++i)
-    bytes += images_[i].bytes() + firstPrim_[i].bytes() + sortKeys_[i].bytes() + sortValues_[i].bytes();
+    bytes += images_[i].bytes() + firstPrim_[i].bytes() + inverseDepth_[i].bytes() + sampleSpacing_[i].bytes() +
+             sortKeys_[i].bytes() + sortValues_[i].bytes();
   return bytes;
 }
 
@@ -405,6 +408,7 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
   EyeOutputs out;
   out.image = image;
   out.firstPrim = (firstPrim_[int(eye)].reserve(pixels, "first-hit ids"), firstPrim_[int(eye)].data());
+  out.inverseDepth = (inverseDepth_[int(eye)].reserve(pixels, "eye depths"), inverseDepth_[int(eye)].data());
   StereoReuseView reuse;
   if (options.stereo != StereoMode::Separate && eye == Eye::Left) {
     surfaces_.reserve(pixels, "left-eye surfaces");
@@ -524,12 +528,14 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
   int gazeX, gazeY;
   options.foveation.gazePixel(int(eye), camera.width, camera.height, gazeX, gazeY);
   images_[int(eye)].reserve(pixels, "eye image");
-  firstPrim_[int(eye)].reserve(pixels, "first-hit ids");
+  inverseDepth_[int(eye)].reserve(pixels, "eye depths");
+  sampleSpacing_[int(eye)].reserve(pixels, "eye sample spacing");
   vertexUsed_.reserve(mask.vertexCount, "mask vertices in use");
   vertexList_.reserve(mask.vertexCount, "mask vertices to shade");
   vertexCount_.reserve(2, "mask vertices shaded");
   vertexPoints_.reserve(mask.vertexCount, "mask vertex gather points");
   vertexColours_.reserve(mask.vertexCount, "mask vertex colours");
+  vertexInverseDepths_.reserve(mask.vertexCount, "mask vertex depths");
   uint32_t* count = vertexCount_.data() + int(eye);
   size_t bytes = 0;
   thrust::counting_iterator<uint32_t> vertices(0);
@@ -548,7 +554,8 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
                                        VertexInUse{vertexUsed_.data()}, stream));
   vertexRaysKernel<<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(scene.view, scene.intersector, params, camera,
                                                                          eye, mask, gazeX, gazeY, vertexList_.data(),
-                                                                         count, vertexPoints_.data());
+                                                                         count, vertexPoints_.data(),
+                                                                         vertexInverseDepths_.data());
   PVR_CUDA_CHECK_LAUNCH("vertexRays");
   timers.rays[0]->stop(stream);
 
@@ -571,12 +578,14 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
   timers.density[0]->stop(stream);
 
   reconstruct.start(stream);
+  // A gaze inside the image leaves no pixel uncovered; these are for the rest.
   PVR_CUDA_CHECK(cudaMemsetAsync(images_[int(eye)].data(), 0, pixels * sizeof(Vec3), stream));
-  rasterKernel<<<blocksFor(size_t(mask.triangleCount) * 32, 256), 256, 0, stream>>>(mask, gazeX, gazeY, vertexColours_.data(),
-                                                                       camera.width, camera.height,
-                                                                       images_[int(eye)].data());
+  PVR_CUDA_CHECK(cudaMemsetAsync(inverseDepth_[int(eye)].data(), 0, pixels * sizeof(float), stream));
+  const VertexValues values{vertexColours_.data(), vertexInverseDepths_.data()};
+  const RasterTarget target{images_[int(eye)].data(), inverseDepth_[int(eye)].data(), sampleSpacing_[int(eye)].data(),
+                            camera.width, camera.height};
+  rasterKernel<<<blocksFor(size_t(mask.triangleCount) * 32, 256), 256, 0, stream>>>(mask, gazeX, gazeY, values, target);
   PVR_CUDA_CHECK_LAUNCH("raster");
-  PVR_CUDA_CHECK(cudaMemsetAsync(firstPrim_[int(eye)].data(), 0xff, pixels * sizeof(uint32_t), stream));
   reconstruct.stop(stream);
 }
 

@@ -44,6 +44,7 @@ struct EyeTimers {
 struct EyeOutputs {
   Vec3* image = nullptr;
   uint32_t* firstPrim = nullptr;
+  float* inverseDepth = nullptr;
   SurfaceRecord* surfaces = nullptr;  ///< the left eye under stereo reuse
   uint32_t* reusedFrom = nullptr;     ///< the right eye under stereo reuse
   unsigned* reusedCount = nullptr;    ///< with reusedFrom: pixels that took the left eye's shading
@@ -58,13 +59,14 @@ struct DeviceMaskView {
 
 class GpuGather {
  public:
-  // Shades one eye into image(eye) and firstPrim(eye); times its stages on `timers`. Under stereo
+  // Shades one eye into image(eye), firstPrim(eye) and inverseDepth(eye); times its stages on `timers`. Under stereo
   // reuse (options.stereo) the left eye records its surfaces and the right eye, rendered after
   // it (and after scatter() for Scatter), takes the left eye's shading where it may.
   void renderEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options, const StereoRig& rig,
                  Eye eye, cudaStream_t stream, EyeTimers& timers);
   // Foveated: lists the mask's vertices in use for the eye's gaze, shades them (eye rays, then
-  // estimates) and rasterizes the eye's image from them (timed on `reconstruct`).
+  // estimates) and rasterizes the eye's image, depth and sample spacing from them (timed on
+  // `reconstruct`); firstPrim(eye) is not written.
   void renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const RenderOptions& options, const StereoRig& rig,
                          Eye eye, const DeviceMaskView& mask, cudaStream_t stream, EyeTimers& timers,
                          EventTimer& reconstruct);
@@ -74,6 +76,8 @@ class GpuGather {
   void scatter(const DeviceScene& scene, const StereoRig& rig, cudaStream_t stream);
   const Vec3* image(Eye e) const { return images_[int(e)].data(); }
   const uint32_t* firstPrim(Eye e) const { return firstPrim_[int(e)].data(); }
+  const float* inverseDepth(Eye e) const { return inverseDepth_[int(e)].data(); }
+  const float* sampleSpacing(Eye e) const { return sampleSpacing_[int(e)].data(); }  ///< foveated only
   const uint32_t* reusedFrom() const { return reusedFrom_.data(); }
   // The right eye's reused-pixel count, copied to the host when the stream reaches it.
   void downloadReusedCount(unsigned* host, cudaStream_t stream) const;
@@ -82,6 +86,7 @@ class GpuGather {
  private:
   DeviceBuffer<Vec3> images_[2];
   DeviceBuffer<uint32_t> firstPrim_[2];
+  DeviceBuffer<float> inverseDepth_[2], sampleSpacing_[2];
   DeviceBuffer<SurfaceRecord> surfaces_;
   DeviceBuffer<uint64_t> scattered_;
   DeviceBuffer<uint32_t> reusedFrom_;
@@ -91,6 +96,7 @@ class GpuGather {
   DeviceBuffer<uint32_t> vertexList_, vertexCount_;  ///< foveated: the vertices shaded (count per eye)
   DeviceBuffer<GatherPoint> vertexPoints_;
   DeviceBuffer<Vec3> vertexColours_;
+  DeviceBuffer<float> vertexInverseDepths_;
   DeviceBuffer<GatherPoint> points_;
   DeviceBuffer<uint32_t> sortKeys_[2], sortValues_[2];
   DeviceBuffer<unsigned char> temp_;

@@ -182,17 +182,35 @@ FoveationMask loadFoveationMask(const std::string& path) {
   return mask;
 }
 
-Image reconstructFoveatedImage(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours) {
-  if (vertexColours.size() != mask.offsets.size()) throw Error("reconstruction needs one colour per mask vertex");
-  const int w = mask.params.width, h = mask.params.height;
-  Image image(w, h);
+namespace {
+
+void rasterizeMask(const FoveationMask& mask, int gazeX, int gazeY, const VertexValues& in, const RasterTarget& out) {
   // Each pixel centre belongs to one triangle: triangles write disjoint pixels, in parallel.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, mask.triangleCount(), 512), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); ++t)
-      rasterizeTriangle(mask.offsets.data(), mask.triangles.data(), t, gazeX, gazeY, vertexColours.data(), w, h,
-                        image.pixels.data());
+      rasterizeTriangle(mask.offsets.data(), mask.triangles.data(), t, gazeX, gazeY, in, out);
   });
+}
+
+}  // namespace
+
+Image reconstructFoveatedImage(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours) {
+  if (vertexColours.size() != mask.offsets.size()) throw Error("reconstruction needs one colour per mask vertex");
+  Image image(mask.params.width, mask.params.height);
+  rasterizeMask(mask, gazeX, gazeY, {vertexColours.data()}, {image.pixels.data(), nullptr, nullptr, image.width, image.height});
   return image;
+}
+
+void reconstructFoveatedEye(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours,
+                            const std::vector<float>& vertexInverseDepths, EyeResult& eye) {
+  if (vertexColours.size() != mask.offsets.size() || vertexInverseDepths.size() != mask.offsets.size())
+    throw Error("reconstruction needs one colour and one depth per mask vertex");
+  const int w = mask.params.width, h = mask.params.height;
+  eye.image = Image(w, h);
+  eye.inverseDepth.assign(size_t(w) * h, 0.0f);
+  eye.sampleSpacing.assign(size_t(w) * h, 1.0f);
+  rasterizeMask(mask, gazeX, gazeY, {vertexColours.data(), vertexInverseDepths.data()},
+                {eye.image.pixels.data(), eye.inverseDepth.data(), eye.sampleSpacing.data(), w, h});
 }
 
 void checkMaskFits(const FoveationMask& mask, int width, int height) {

@@ -78,11 +78,17 @@ PVR_HOST_DEVICE inline bool triangleBounds(const MaskPoint v[3], int width, int 
   return x0 < x1 && y0 < y1;
 }
 
-// Writes the pixels of `image` (width x height) whose centres triangle t covers; the caller may
-// split the triangle's bounding box between `stride` workers (pixels first, first + stride, ...).
-PVR_HOST_DEVICE inline void rasterizeTriangle(const MaskPoint* offsets, const uint32_t* triangles, size_t t,
-                                              int gazeX, int gazeY, const Vec3* vertexColours, int width, int height,
-                                              Vec3* image, int first = 0, int stride = 1);
+// A mask's per-vertex values, and what the raster writes per pixel (null pointers: nothing).
+struct VertexValues {
+  const Vec3* colours = nullptr;
+  const float* inverseDepths = nullptr;  ///< first-hit inverse depths, blended for TAA's reprojection
+};
+struct RasterTarget {
+  Vec3* image = nullptr;
+  float* inverseDepth = nullptr;   ///< inverse depth is affine in the image: exact on planes
+  float* sampleSpacing = nullptr;  ///< the covering triangle's size, sqrt(2 area): 1 on the pixel grid
+  int width = 0, height = 0;
+};
 
 PVR_HOST_DEVICE inline Vec3 blend(const double weight[3], Vec3 c0, Vec3 c1, Vec3 c2) {
   return {float(weight[0] * c0.x + weight[1] * c1.x + weight[2] * c2.x),
@@ -90,20 +96,28 @@ PVR_HOST_DEVICE inline Vec3 blend(const double weight[3], Vec3 c0, Vec3 c1, Vec3
           float(weight[0] * c0.z + weight[1] * c1.z + weight[2] * c2.z)};
 }
 
+// Writes the pixels whose centres triangle t covers; the caller may split the triangle's bounding
+// box between `stride` workers (pixels first, first + stride, ...).
 PVR_HOST_DEVICE inline void rasterizeTriangle(const MaskPoint* offsets, const uint32_t* triangles, size_t t,
-                                              int gazeX, int gazeY, const Vec3* vertexColours, int width, int height,
-                                              Vec3* image, int first, int stride) {
+                                              int gazeX, int gazeY, const VertexValues& in, const RasterTarget& out,
+                                              int first = 0, int stride = 1) {
   MaskPoint v[3];
   uint32_t index[3];
   placeTriangle(offsets, triangles, t, gazeX, gazeY, v, index);
   int x0, x1, y0, y1;
-  if (!triangleBounds(v, width, height, x0, x1, y0, y1)) return;
+  if (!triangleBounds(v, out.width, out.height, x0, x1, y0, y1)) return;
+  const float spacing = float(sqrt(fabs(orient2d(v[0], v[1], double(v[2].x), double(v[2].y)))));
   const int boxWidth = x1 - x0, boxPixels = boxWidth * (y1 - y0);
   for (int k = first; k < boxPixels; k += stride) {
     int x = x0 + k % boxWidth, y = y0 + k / boxWidth;
     double weight[3];
-    if (coveredBy(v, index, x + 0.5, y + 0.5, weight))
-      image[size_t(y) * width + x] = blend(weight, vertexColours[index[0]], vertexColours[index[1]], vertexColours[index[2]]);
+    if (!coveredBy(v, index, x + 0.5, y + 0.5, weight)) continue;
+    const size_t pixel = size_t(y) * out.width + x;
+    out.image[pixel] = blend(weight, in.colours[index[0]], in.colours[index[1]], in.colours[index[2]]);
+    if (out.inverseDepth)
+      out.inverseDepth[pixel] = float(weight[0] * in.inverseDepths[index[0]] + weight[1] * in.inverseDepths[index[1]] +
+                                      weight[2] * in.inverseDepths[index[2]]);
+    if (out.sampleSpacing) out.sampleSpacing[pixel] = spacing;
   }
 }
 

@@ -74,6 +74,12 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
     if (o.stereo != StereoMode::Separate)
       throw Error("foveated rendering with stereo reuse is not implemented yet: use --stereo separate");
   }
+  if (o.temporal.enabled) {
+    const TaaParams& t = o.temporal.taa;
+    if (!(t.blend > 0.0f && t.blend <= 1.0f)) throw Error("the TAA blend must be in (0, 1]");
+    if (!(t.depthTolerance > 0.0f && t.depthTolerance < 1.0f))
+      throw Error("the TAA depth tolerance must be in (0, 1)");
+  }
   if (o.stereo != StereoMode::Separate && !(o.eyes[0] && o.eyes[1]))
     throw Error(std::string("stereo reuse (") + stereoModeName(o.stereo) + ") renders the right eye from the left: it needs both eyes");
 }

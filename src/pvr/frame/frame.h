@@ -10,6 +10,7 @@
 #include "pvr/frame/image.h"
 #include "pvr/photon/gather.h"
 #include "pvr/photon/photon_trace.h"
+#include "pvr/temporal/taa.h"
 
 namespace pvr {
 
@@ -25,6 +26,13 @@ struct FoveationOptions {
     x = std::min(width - 1, std::max(0, int(gaze[eye][0] * float(width))));
     y = std::min(height - 1, std::max(0, int(gaze[eye][1] * float(height))));
   }
+};
+
+// Temporal anti-aliasing across the frames a renderer draws (pvr/temporal/taa.h): each eye's
+// displayed image blends in the previous one, reprojected by depth and the head's motion.
+struct TemporalOptions {
+  bool enabled = false;
+  TaaParams taa;
 };
 
 enum class PhotonMapKind : int { HashGrid = 0, KdTree = 1 };
@@ -52,6 +60,7 @@ struct RenderOptions {
   bool eyes[2] = {true, true};
   StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading
   FoveationOptions foveation;
+  TemporalOptions temporal;
   uint32_t photonCount() const { return photonsX * photonsY; }
   // The photon pass these options ask for (every backend traces the same photons).
   PhotonTraceParams photonTraceParams() const {
@@ -74,12 +83,21 @@ struct StageTimings {
   double scatterMs = 0;
   // Foveated: the reconstruction of each eye's image from its mask vertices (in eyeMs).
   double reconstructMs[2] = {0, 0};
+  // TAA: resolving each eye's image against its history (in eyeMs).
+  double temporalMs[2] = {0, 0};
   double totalMs() const { return photonTraceMs + mapBuildMs + eyeMs[0] + eyeMs[1]; }
 };
 
 struct EyeResult {
-  Image image;
-  std::vector<uint32_t> firstPrim;  ///< per pixel, the triangle its centre ray hit first (~0u: none)
+  Image image;  ///< what the eye is shown: after TAA when it is on
+  /// Per pixel, the triangle its centre ray hit first (~0u: none); empty for foveated frames,
+  /// whose pixels are blends of several rays.
+  std::vector<uint32_t> firstPrim;
+  /// Per pixel, 1 / view depth of what it shows (0: nothing hit); foveated: blended from the
+  /// vertices' like the colour.
+  std::vector<float> inverseDepth;
+  /// Foveated: per pixel, the spacing in pixels of the samples it was rebuilt from. Empty: 1.
+  std::vector<float> sampleSpacing;
   /// The right eye under stereo reuse: per pixel, the left pixel whose shading it took
   /// (kNotReused: shaded here). Empty otherwise.
   std::vector<uint32_t> reusedFrom;
@@ -93,6 +111,7 @@ struct FrameResult {
   size_t deviceBytes = 0;  ///< GPU memory held by the backend (0 on the CPU)
   size_t reusedPixels = 0;  ///< right-eye pixels that took the left eye's shading
   size_t shadedSamples[2] = {0, 0};  ///< per eye: pixels, or mask vertices when foveated
+  size_t historyPixels[2] = {0, 0};  ///< TAA: per eye, pixels that blended in their history
 };
 
 // Sets the rig's per-eye resolution from "WxH" (1x1 .. 8192x8192); throws pvr::Error naming
@@ -107,7 +126,11 @@ class FrameRenderer {
   virtual ~FrameRenderer() = default;
   // Traces photons, builds the map and shades the requested eyes. With images = false the
   // images stay where they were rendered (benchmarks).
+  // With options.temporal on, each eye's image is blended with the renderer's history of the
+  // frames before (kept per eye; an eye whose size changed starts again).
   virtual FrameResult render(const StereoRig& rig, const RenderOptions& options, bool images = true) = 0;
+  // Forgets the TAA history (a cut: the next frame is shown as rendered).
+  virtual void resetHistory() = 0;
   virtual std::string name() const = 0;  ///< "cpu" or "cuda"
   virtual std::string deviceName() const = 0;
 };

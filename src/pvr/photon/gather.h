@@ -29,6 +29,7 @@ struct GatherParams {
 struct PixelSample {
   Vec3 radiance{0, 0, 0};
   uint32_t firstPrim = ~0u;          ///< triangle seen first by the pixel's centre sample, ~0u for none
+  float inverseDepth = 0.0f;         ///< 1 / view depth of that first hit (EyeCamera::inverseDepthOf), 0 for none
   uint32_t reusedFrom = kNotReused;  ///< the other eye's pixel whose shading this pixel took
 };
 
@@ -120,19 +121,30 @@ PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeC
   return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 
+// The inverse view depth of a camera ray's first hit (0: none).
+PVR_HOST_DEVICE inline float firstHitInverseDepth(const EyeCamera& camera, const Ray& ray, const Hit& first) {
+  return first.valid() ? camera.inverseDepthOf(ray.origin + ray.dir * first.t) : 0.0f;
+}
+
 // The gather point seen through a continuous image position (a foveation mask's vertex), with the
 // random numbers of the pixel it lies in: a vertex on a pixel centre is shaded exactly as that
-// pixel's first sample. Positions outside the image get streams of their own.
+// pixel's first sample. Positions outside the image get streams of their own. `inverseDepth`, if
+// given, receives the first hit's (for temporal reprojection).
 template <class Intersector>
 PVR_HOST_DEVICE GatherPoint imagePositionGatherPoint(const SceneView& scene, const Intersector& intersector,
                                                      const GatherParams& params, const EyeCamera& camera, Eye eye,
-                                                     float px, float py) {
+                                                     float px, float py, float* inverseDepth = nullptr) {
   int ix = int(floorf(px)), iy = int(floorf(py));
   bool inside = ix >= 0 && iy >= 0 && ix < camera.width && iy < camera.height;
   uint32_t stream = inside ? uint32_t(iy) * uint32_t(camera.width) + uint32_t(ix)
                            : hashCombine(hashCombine(0x9e3779b9u, uint32_t(ix)), uint32_t(iy)) | 0x80000000u;
   CounterRng rng = pixelRng(params, eye, stream, 0);
-  return traceToDiffuse(scene, intersector, params, camera.generateRay(px, py), rng);
+  Ray ray = camera.generateRay(px, py);
+  if (!inverseDepth) return traceToDiffuse(scene, intersector, params, ray, rng);
+  Hit first;
+  intersector.intersect(ray, INFINITY, first);
+  *inverseDepth = firstHitInverseDepth(camera, ray, first);
+  return traceToDiffuse(scene, intersector, params, ray, rng, &first);
 }
 
 template <class Intersector, class PhotonMap>
@@ -157,7 +169,11 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   GatherPoint reused;
   if (s == 0 && reuse.mode == StereoMode::Scatter) {
     pixel.reusedFrom = scatteredSource(reuse.scattered[size_t(y) * camera.width + x]);
-    if (pixel.reusedFrom != kNotReused) pixel.firstPrim = reuse.sourceSurfaces[pixel.reusedFrom].prim;
+    if (pixel.reusedFrom != kNotReused) {
+      const SurfaceRecord& source = reuse.sourceSurfaces[pixel.reusedFrom];
+      pixel.firstPrim = source.prim;
+      pixel.inverseDepth = camera.inverseDepthOf(source.position);
+    }
   }
   if (pixel.reusedFrom != kNotReused) {
     reused.radiance = reuse.sourceImage[pixel.reusedFrom];
@@ -169,6 +185,7 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   Hit first;
   intersector.intersect(ray, INFINITY, first);
   pixel.firstPrim = first.primId;
+  pixel.inverseDepth = firstHitInverseDepth(camera, ray, first);
   if (surfaceOut) *surfaceOut = surfaceRecordOf(scene, camera, ray, first);
   if (reuse.mode == StereoMode::Gather) {
     pixel.reusedFrom = gatherSource(reuse, surfaceRecordOf(scene, camera, ray, first));

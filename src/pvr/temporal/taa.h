@@ -1,0 +1,139 @@
+#pragma once
+// Temporal anti-aliasing (TAA) of one eye's image, host+device: each pixel's displayed colour
+// blends the current frame with the previous displayed frame, reprojected through the current
+// frame's depth and both frames' cameras (head motion). The reprojected history is
+//  - rejected where the previous frame saw another surface there (disocclusion: its depth does
+//    not match) or did not see the point at all (off its image): the pixel restarts from the
+//    current frame;
+//  - clamped to the colour range of the pixel's current neighbourhood, so that what changed
+//    (moving light, a mirror's reflection) does not leave a ghost.
+// Foveated frames are reconstructed from samples several pixels apart in the periphery; the
+// neighbourhood there is scaled to the local sample spacing, so it spans neighbouring samples as
+// a 3x3 neighbourhood does at full resolution.
+#include "pvr/camera/stereo_rig.h"
+
+namespace pvr {
+
+struct TaaParams {
+  float blend = 0.1f;            ///< weight of the current frame (1: no history); in (0, 1]
+  float depthTolerance = 0.02f;  ///< relative depth difference beyond which history is another surface
+  bool clampToNeighbourhood = true;
+};
+
+// One eye's frame and its history, as device or host pointers.
+struct TaaView {
+  EyeCamera camera, previousCamera;
+  const Vec3* current = nullptr;
+  const float* inverseDepth = nullptr;   ///< current frame, per pixel (0: nothing hit)
+  const float* sampleSpacing = nullptr;  ///< current frame, pixels between samples; null: 1
+  const Vec3* history = nullptr;         ///< previous displayed frame (previousCamera's size); null: none
+  const float* historyInverseDepth = nullptr;
+  TaaParams params;
+};
+
+PVR_HOST_DEVICE inline Vec3 clampedPixel(const Vec3* image, int width, int height, int x, int y) {
+  x = x < 0 ? 0 : (x >= width ? width - 1 : x);
+  y = y < 0 ? 0 : (y >= height ? height - 1 : y);
+  return image[size_t(y) * width + x];
+}
+
+// Catmull-Rom weights of the four samples around a point at fraction t past the second one.
+PVR_HOST_DEVICE inline void catmullRomWeights(float t, float w[4]) {
+  w[0] = t * (-0.5f + t * (1.0f - 0.5f * t));
+  w[1] = 1.0f + t * t * (-2.5f + 1.5f * t);
+  w[2] = t * (0.5f + t * (2.0f - 1.5f * t));
+  w[3] = t * t * (-0.5f + 0.5f * t);
+}
+
+// The image at continuous pixel position (px, py) by Catmull-Rom (bicubic) interpolation: unlike
+// bilinear it does not blur the history a little more every frame the head moves. At a pixel
+// centre it returns that pixel.
+PVR_HOST_DEVICE inline Vec3 sampleCatmullRom(const Vec3* image, int width, int height, float px, float py) {
+  float fx = px - 0.5f, fy = py - 0.5f;
+  float bx = floorf(fx), by = floorf(fy);
+  float wx[4], wy[4];
+  catmullRomWeights(fx - bx, wx);
+  catmullRomWeights(fy - by, wy);
+  Vec3 sum{0, 0, 0};
+  for (int j = 0; j < 4; ++j) {
+    Vec3 row{0, 0, 0};
+    for (int i = 0; i < 4; ++i) row += clampedPixel(image, width, height, int(bx) - 1 + i, int(by) - 1 + j) * wx[i];
+    sum += row * wy[j];
+  }
+  return sum;
+}
+
+// Where pixel (x, y)'s centre was in the previous frame, and the inverse depth it had there. Points
+// at infinity (nothing hit) move with the head's rotation only. False if the previous eye did not
+// see it (behind it, or outside its image).
+PVR_HOST_DEVICE inline bool reprojectToPrevious(const TaaView& v, int x, int y, float& px, float& py,
+                                                float& previousInverseDepth) {
+  float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+  float w = v.inverseDepth[size_t(y) * v.camera.width + x];
+  bool inFront;
+  if (w > 0.0f) {
+    Vec3 world = v.camera.pointAt(cx, cy, w);
+    previousInverseDepth = v.previousCamera.inverseDepthOf(world);
+    inFront = v.previousCamera.project(world, px, py);
+  } else {
+    previousInverseDepth = 0.0f;
+    inFront = v.previousCamera.projectDirection(v.camera.pose.toWorldDir(v.camera.localDirection(cx, cy)), px, py);
+  }
+  return inFront && v.previousCamera.containsPixel(px, py);
+}
+
+// Whether one of the four previous pixels around (px, py) saw a surface at the expected depth.
+// Comparing inverse depths relatively compares depths relatively; both 0 (background) match.
+PVR_HOST_DEVICE inline bool previousSawSameSurface(const TaaView& v, float px, float py, float expected) {
+  const int w = v.previousCamera.width, h = v.previousCamera.height;
+  int x0 = int(floorf(px - 0.5f)), y0 = int(floorf(py - 0.5f));
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      int x = x0 + i < 0 ? 0 : (x0 + i >= w ? w - 1 : x0 + i);
+      int y = y0 + j < 0 ? 0 : (y0 + j >= h ? h - 1 : y0 + j);
+      float d = v.historyInverseDepth[size_t(y) * w + x];
+      if (fabsf(d - expected) <= v.params.depthTolerance * fmaxf(d, expected)) return true;
+    }
+  return false;
+}
+
+// The current frame's colour range around pixel (x, y): a 3x3 neighbourhood whose step is the
+// local sample spacing (one pixel at full resolution).
+PVR_HOST_DEVICE inline void neighbourhoodRange(const TaaView& v, int x, int y, Vec3& lo, Vec3& hi) {
+  const int w = v.camera.width, h = v.camera.height;
+  int step = 1;
+  if (v.sampleSpacing) {
+    float s = v.sampleSpacing[size_t(y) * w + x];
+    step = s > 1.5f ? int(s + 0.5f) : 1;
+  }
+  lo = hi = v.current[size_t(y) * w + x];
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) {
+      Vec3 c = clampedPixel(v.current, w, h, x + i * step, y + j * step);
+      lo = min(lo, c);
+      hi = max(hi, c);
+    }
+}
+
+// The displayed colour of pixel (x, y); `usedHistory` says whether the history contributed
+// (false: first frame, disocclusion, or the point was off the previous image).
+PVR_HOST_DEVICE inline Vec3 resolveTemporalPixel(const TaaView& v, int x, int y, bool& usedHistory) {
+  const size_t pixel = size_t(y) * v.camera.width + x;
+  const Vec3 current = v.current[pixel];
+  usedHistory = false;
+  if (!v.history) return current;
+  float px, py, expected;
+  if (!reprojectToPrevious(v, x, y, px, py, expected) || !previousSawSameSurface(v, px, py, expected)) return current;
+  Vec3 history = sampleCatmullRom(v.history, v.previousCamera.width, v.previousCamera.height, px, py);
+  if (v.params.clampToNeighbourhood) {
+    Vec3 lo, hi;
+    neighbourhoodRange(v, x, y, lo, hi);
+    history = min(max(history, lo), hi);
+  } else {
+    history = max(history, Vec3(0.0f));  // Catmull-Rom's lobes can undershoot
+  }
+  usedHistory = true;
+  return history + (current - history) * v.params.blend;
+}
+
+}  // namespace pvr
