@@ -57,6 +57,11 @@ expect_error "not implemented yet" render cornell --foveated --stereo gather --e
 expect_error "mask is for 32x32" render cornell --foveated --mask "$out/m32.pvrmask" --eye-size 16x16
 expect_error "cannot open trajectory" render cornell --trajectory "$data/missing.txt" --eye-size 8x8
 expect_error "line 2: .mtllib. is not a number" render cornell --trajectory "$data/box.obj" --eye-size 8x8
+expect_error "--taa-blend is for --taa" render cornell --taa-blend 0.5 --eye-size 8x8
+expect_error "--taa-blend must be in (0, 1\]" render cornell --taa --taa-blend 0 --eye-size 8x8
+expect_error "--taa-blend must be in (0, 1\]" render cornell --taa --taa-blend 1.5 --eye-size 8x8
+expect_error "--taa-blend" render cornell --taa --taa-blend nan --eye-size 8x8
+expect_error "--taa-blend" render cornell --taa --taa-blend 0.5x --eye-size 8x8
 expect_error "--suite must be" bench --suite speed
 expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1

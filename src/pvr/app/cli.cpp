@@ -77,6 +77,8 @@ struct RenderArgs {
   std::string mask;          // empty: made for the rig at start
   std::string gaze = "0.5,0.5";
   std::string trajectory;    // one frame per line: head pose + gaze
+  bool taa = false;
+  std::string taaBlend;      // empty: TaaParams' default
   std::string out = "out/render";
   float exposure = 1.0f;
 };
@@ -171,6 +173,13 @@ int runRender(const RenderArgs& a) {
   } else if (!a.mask.empty()) {
     throw Error("--mask is for --foveated rendering");
   }
+  if (!a.taaBlend.empty() && !a.taa) throw Error("--taa-blend is for --taa");
+  if (a.taa) {
+    options.temporal.enabled = true;
+    if (!a.taaBlend.empty()) options.temporal.taa.blend = parseFloat(a.taaBlend, "--taa-blend");
+    if (!(options.temporal.taa.blend > 0.0f && options.temporal.taa.blend <= 1.0f))
+      throw Error("--taa-blend must be in (0, 1], got '" + a.taaBlend + "'");
+  }
   std::vector<TrajectoryFrame> trajectory;
   if (!a.trajectory.empty()) trajectory = loadTrajectory(a.trajectory);
   ensureParentDirectory(a.out);  // before the work, not after it
@@ -196,9 +205,14 @@ int runRender(const RenderArgs& a) {
       totalMs += frame.timings.totalMs();
       char prefix[32];
       std::snprintf(prefix, sizeof prefix, "_%04zu", f);
-      std::printf("frame %4zu: %8.2f ms (left eye %.2f, right eye %.2f), %zu + %zu samples shaded\n", f,
+      std::printf("frame %4zu: %8.2f ms (left eye %.2f, right eye %.2f), %zu + %zu samples shaded", f,
                   frame.timings.totalMs(), frame.timings.eyeMs[0], frame.timings.eyeMs[1], frame.shadedSamples[0],
                   frame.shadedSamples[1]);
+      if (options.temporal.enabled) {
+        double pixels = double(rig.width) * rig.height * ((options.eyes[0] ? 1 : 0) + (options.eyes[1] ? 1 : 0));
+        std::printf(", TAA history kept on %.1f%% of pixels", 100.0 * double(frame.historyPixels[0] + frame.historyPixels[1]) / pixels);
+      }
+      std::printf("\n");
       for (int e = 0; e < 2; ++e)
         if (options.eyes[e])
           for (const char* ext : {".png", ".exr"}) writeImage(frame.eyes[e].image, a.out + prefix + "_" + names[e] + ext, a.exposure);
@@ -319,13 +333,17 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   render->add_option("--exposure", ra.exposure, "Scale applied before the sRGB PNG's clamp")->capture_default_str();
   render->add_flag("--foveated", ra.foveated,
-                   "Foveated: shade only a foveation mask's vertices around the gaze and reconstruct (CPU backend)");
+                   "Foveated: shade only a foveation mask's vertices around the gaze and reconstruct");
   render->add_option("--mask", ra.mask, "Foveation mask file from `photonvr mask` (default: made for the rig at start)");
   render->add_option("--gaze", ra.gaze, "Gaze point X,Y as fractions of the image (0.5,0.5 = centre)")
       ->capture_default_str();
   render->add_option("--trajectory", ra.trajectory,
                      "Render one frame per line of FILE: 'px py pz qx qy qz qw gx gy' (head pose; gaze as image "
                      "fractions, used with --foveated), or 11 numbers with a gaze per eye; '#' comments");
+  render->add_flag("--taa", ra.taa,
+                   "Temporal anti-aliasing across --trajectory frames: reprojection by depth and head motion, "
+                   "neighbourhood clamping, reset on disocclusion");
+  render->add_option("--taa-blend", ra.taaBlend, "Weight of the current frame under --taa, in (0, 1] (default 0.1)");
   render->add_option("--out", ra.out, "Output prefix: writes PREFIX_left.png/.exr and PREFIX_right.png/.exr")
       ->capture_default_str();
 

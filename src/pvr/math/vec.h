@@ -68,6 +68,7 @@ PVR_HOST_DEVICE inline Vec3 min(Vec3 a, Vec3 b) {
 PVR_HOST_DEVICE inline Vec3 max(Vec3 a, Vec3 b) {
   return {fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)};
 }
+PVR_HOST_DEVICE inline Vec3 abs(Vec3 a) { return {fabsf(a.x), fabsf(a.y), fabsf(a.z)}; }
 PVR_HOST_DEVICE inline float maxComponent(Vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
 PVR_HOST_DEVICE inline float luminance(Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 PVR_HOST_DEVICE inline bool isFinite(Vec3 a) {

@@ -82,30 +82,61 @@ PVR_HOST_DEVICE inline bool reprojectToPrevious(const TaaView& v, int x, int y, 
   return inFront && v.previousCamera.containsPixel(px, py);
 }
 
-// Whether one of the four previous pixels around (px, py) saw a surface at the expected depth.
-// Comparing inverse depths relatively compares depths relatively; both 0 (background) match.
-PVR_HOST_DEVICE inline bool previousSawSameSurface(const TaaView& v, float px, float py, float expected) {
+// Pixels between a frame's samples at pixel (x, y): 1 at full resolution, the mask's local spacing
+// when foveated.
+PVR_HOST_DEVICE inline int sampleStep(const TaaView& v, int x, int y) {
+  if (!v.sampleSpacing) return 1;
+  float s = v.sampleSpacing[size_t(y) * v.camera.width + x];
+  return s > 1.5f ? int(s + 0.5f) : 1;
+}
+
+// Whether the previous frame saw a surface at the expected depth around (px, py). At full
+// resolution: one of the four pixels around it, or their bilinear blend, within the tolerance
+// (inverse depths compared relatively compare depths relatively; background, 0, matches
+// background). Where the current
+// frame was rebuilt from samples `step` pixels apart its depth is a blend across that distance
+// (silhouettes included), so the depth is accepted anywhere within the range the previous frame
+// had within one step: a moving gaze alone does not throw history away.
+PVR_HOST_DEVICE inline bool previousSawSameSurface(const TaaView& v, float px, float py, float expected, int step) {
   const int w = v.previousCamera.width, h = v.previousCamera.height;
-  int x0 = int(floorf(px - 0.5f)), y0 = int(floorf(py - 0.5f));
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i) {
-      int x = x0 + i < 0 ? 0 : (x0 + i >= w ? w - 1 : x0 + i);
-      int y = y0 + j < 0 ? 0 : (y0 + j >= h ? h - 1 : y0 + j);
+  const float tolerance = v.params.depthTolerance;
+  if (step == 1) {
+    const float fx = px - 0.5f, fy = py - 0.5f;
+    const int x0 = int(floorf(fx)), y0 = int(floorf(fy));
+    const float tx = fx - floorf(fx), ty = fy - floorf(fy);
+    float bilinear = 0.0f;
+    bool near = false;
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) {
+        int x = x0 + i < 0 ? 0 : (x0 + i >= w ? w - 1 : x0 + i);
+        int y = y0 + j < 0 ? 0 : (y0 + j >= h ? h - 1 : y0 + j);
+        float d = v.historyInverseDepth[size_t(y) * w + x];
+        near = near || fabsf(d - expected) <= tolerance * fmaxf(d, expected);
+        bilinear += d * (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
+      }
+    // Inverse depth is affine across a plane, so its bilinear blend is exact there even where
+    // the plane is seen at a grazing angle; a single close pixel keeps silhouettes.
+    return near || fabsf(bilinear - expected) <= tolerance * fmaxf(bilinear, expected);
+  }
+  int cx = int(px), cy = int(py);
+  float lo = INFINITY, hi = 0.0f;
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) {
+      int x = cx + i * step, y = cy + j * step;
+      x = x < 0 ? 0 : (x >= w ? w - 1 : x);
+      y = y < 0 ? 0 : (y >= h ? h - 1 : y);
       float d = v.historyInverseDepth[size_t(y) * w + x];
-      if (fabsf(d - expected) <= v.params.depthTolerance * fmaxf(d, expected)) return true;
+      lo = fminf(lo, d);
+      hi = fmaxf(hi, d);
     }
-  return false;
+  return expected >= lo * (1.0f - tolerance) && expected <= hi * (1.0f + tolerance);
 }
 
 // The current frame's colour range around pixel (x, y): a 3x3 neighbourhood whose step is the
 // local sample spacing (one pixel at full resolution).
 PVR_HOST_DEVICE inline void neighbourhoodRange(const TaaView& v, int x, int y, Vec3& lo, Vec3& hi) {
   const int w = v.camera.width, h = v.camera.height;
-  int step = 1;
-  if (v.sampleSpacing) {
-    float s = v.sampleSpacing[size_t(y) * w + x];
-    step = s > 1.5f ? int(s + 0.5f) : 1;
-  }
+  const int step = sampleStep(v, x, y);
   lo = hi = v.current[size_t(y) * w + x];
   for (int j = -1; j <= 1; ++j)
     for (int i = -1; i <= 1; ++i) {
@@ -123,7 +154,9 @@ PVR_HOST_DEVICE inline Vec3 resolveTemporalPixel(const TaaView& v, int x, int y,
   usedHistory = false;
   if (!v.history) return current;
   float px, py, expected;
-  if (!reprojectToPrevious(v, x, y, px, py, expected) || !previousSawSameSurface(v, px, py, expected)) return current;
+  if (!reprojectToPrevious(v, x, y, px, py, expected) ||
+      !previousSawSameSurface(v, px, py, expected, sampleStep(v, x, y)))
+    return current;
   Vec3 history = sampleCatmullRom(v.history, v.previousCamera.width, v.previousCamera.height, px, py);
   if (v.params.clampToNeighbourhood) {
     Vec3 lo, hi;
