@@ -13,6 +13,20 @@
 namespace pvr {
 namespace {
 
+// Mean absolute difference of two images relative to the first's mean (all channels).
+double relativeDifference(const Image& a, const Image& b) {
+  double sum = 0, diff = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) sum += std::fabs(a.pixels[i][c]), diff += std::fabs(a.pixels[i][c] - b.pixels[i][c]);
+  return diff / std::max(sum, 1e-30);
+}
+
+double relativeDifference(const std::vector<float>& a, const std::vector<float>& b) {
+  double sum = 0, diff = 0;
+  for (size_t i = 0; i < a.size(); ++i) sum += std::fabs(a[i]), diff += std::fabs(a[i] - b[i]);
+  return diff / std::max(sum, 1e-30);
+}
+
 #define PVR_REQUIRE_GPU()                                          \
   do {                                                             \
     std::string why;                                               \
@@ -199,13 +213,52 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
     o.foveation.gaze[1][0] = 0.65f, o.foveation.gaze[1][1] = 0.4f;
     FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
     for (int e = 0; e < 2; ++e) {
+      const char* what = estimator == Estimator::Knn ? " knn" : " radius";
       EXPECT_EQ(a.shadedSamples[e], b.shadedSamples[e]);
-      double sum = 0, diff = 0;
-      for (size_t i = 0; i < a.eyes[e].image.pixels.size(); ++i)
-        for (int c = 0; c < 3; ++c)
-          sum += std::fabs(a.eyes[e].image.pixels[i][c]), diff += std::fabs(a.eyes[e].image.pixels[i][c] - b.eyes[e].image.pixels[i][c]);
-      EXPECT_LT(diff / sum, 0.01) << "eye " << e << (estimator == Estimator::Knn ? " knn" : " radius");
+      EXPECT_LT(relativeDifference(a.eyes[e].image, b.eyes[e].image), 0.01) << "eye " << e << what;
+      EXPECT_LT(relativeDifference(a.eyes[e].inverseDepth, b.eyes[e].inverseDepth), 1e-3) << "eye " << e << what;
+      EXPECT_LT(relativeDifference(a.eyes[e].sampleSpacing, b.eyes[e].sampleSpacing), 1e-6) << "eye " << e << what;
+      EXPECT_TRUE(a.eyes[e].firstPrim.empty() && b.eyes[e].firstPrim.empty()) << "foveated frames have no first-hit ids";
     }
+  }
+}
+
+// TAA over a few frames of head motion and a moving gaze, full resolution and foveated: the
+// displayed images, and how many pixels kept their history, agree with the CPU's.
+TEST(GpuBackend, TemporalAntiAliasingMatchesTheCpu) {
+  PVR_REQUIRE_GPU();
+  Scene scene = builtinScene("cornell-caustics");
+  StereoRig rig = scene.rig;
+  rig.width = 320, rig.height = 352;
+  FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
+  CpuFrameRenderer cpu(scene);
+  CudaFrameRenderer gpu(scene);
+  for (bool foveated : {false, true}) {
+    RenderOptions o;
+    o.photonsX = o.photonsY = 128;
+    o.gather.density.radius = 0.08f;
+    o.temporal.enabled = true;
+    o.foveation.mask = foveated ? &mask : nullptr;
+    cpu.resetHistory();
+    gpu.resetHistory();
+    const Pose start = rig.head;
+    for (int f = 0; f < 4; ++f) {
+      rig.head.position = start.toWorldPoint({0.03f * f, 0.01f * f, -0.05f * f});
+      for (auto& g : o.foveation.gaze) g[0] = 0.45f + 0.02f * f, g[1] = 0.5f;
+      FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
+      for (int e = 0; e < 2; ++e) {
+        const std::string what = std::string(foveated ? "foveated" : "full") + ", frame " + std::to_string(f) + ", eye " + std::to_string(e);
+        EXPECT_LT(relativeDifference(a.eyes[e].image, b.eyes[e].image), 0.01) << what;
+        EXPECT_LT(relativeDifference(a.eyes[e].inverseDepth, b.eyes[e].inverseDepth), 1e-3) << what;
+        const double pixels = double(rig.width) * rig.height;
+        EXPECT_NEAR(double(a.historyPixels[e]) / pixels, double(b.historyPixels[e]) / pixels, 0.005) << what;
+        if (f > 0) {
+          EXPECT_GT(double(b.historyPixels[e]), 0.5 * pixels) << what;
+        }
+        EXPECT_GT(b.timings.temporalMs[e], 0.0) << what;
+      }
+    }
+    rig.head = start;
   }
 }
 

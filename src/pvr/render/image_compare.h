@@ -11,6 +11,7 @@ namespace pvr {
 struct ImageComparison {
   double psnr = 0;                ///< dB, peak 1; +infinity for identical images
   double meanSquaredError = 0;
+  double meanAbsoluteDifference = 0;  ///< per channel, in display units (0..1)
   double fractionOver1Percent = 0;  ///< pixels with a channel off by more than 0.01 of the display range
   size_t pixels = 0;               ///< pixels compared
 };
