@@ -416,11 +416,13 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
     std::string name;
     const FoveationMask* mask;
     float gazeX, gazeY;
+    StereoMode stereo = StereoMode::Separate;
   };
   const std::vector<Column> columns = {{"full resolution", nullptr, 0.5f, 0.5f},
                                        {"foveated, linear MAR", &linear, 0.5f, 0.5f},
                                        {"foveated, Geisler-Perry", &geislerPerry, 0.5f, 0.5f},
-                                       {"foveated, linear MAR, gaze (0.3, 0.6)", &linear, 0.3f, 0.6f}};
+                                       {"foveated, linear MAR, gaze (0.3, 0.6)", &linear, 0.3f, 0.6f},
+                                       {"foveated, linear MAR, stereo gather", &linear, 0.5f, 0.5f, StereoMode::Gather}};
   const std::vector<std::pair<float, float>> rings = {{0, 5}, {5, 10}, {10, 20}, {20, 40}, {40, 180}};
   std::printf("\nFoveated rendering on %s (%s backend): scene %s, both eyes %dx%d, 512x512 photons, r = 0.05, radius "
               "estimate, photon-map-only shading, %d frames after %d warm-up. Masks: %zu vertices (linear MAR, "
@@ -434,12 +436,14 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
   int failures = 0;
   double fullEyeMs = 0;
   FrameResult reference;
+  std::string reuseNotes;
   for (size_t c = 0; c < columns.size(); ++c) {
     RenderOptions o;
     o.photonsX = o.photonsY = 512;
     o.gather.mode = ShadingMode::PhotonMapOnly;
     o.gather.density.radius = 0.05f;
     o.foveation.mask = columns[c].mask;
+    o.stereo = columns[c].stereo;
     for (auto& g : o.foveation.gaze) g[0] = columns[c].gazeX, g[1] = columns[c].gazeY;
     CellResult cell = timeCell(renderer, rig, o, args.warmup, args.frames);
     double eyeMs = cell.eyeMs[0] + cell.eyeMs[1];
@@ -469,6 +473,11 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
                 cell.reconstructMs, samples, pixels / std::max(samples, 1.0), fullEyeMs / std::max(eyeMs, 1e-9));
     for (double p : psnr) std::printf(c == 0 ? " ref |" : " %.1f |", p);
     std::printf(" %s |\n", ok ? "ok" : "MISMATCH");
+    const double rightLeft = cell.eyeMs[1] / std::max(cell.eyeMs[0], 1e-9);
+    const double reusedShare = double(cell.reusedPixels) / std::max(samples, 1.0);
+    if (columns[c].stereo != StereoMode::Separate)
+      reuseNotes += "- " + columns[c].name + ": the right eye took " + std::to_string(int(100.0 * reusedShare + 0.5)) +
+                    "% of its vertices from the left; right/left eye time " + std::to_string(rightLeft).substr(0, 4) + "\n";
     nlohmann::json ringJson = nlohmann::json::array();
     for (size_t r = 0; r < rings.size(); ++r)
       ringJson.push_back({{"from_deg", rings[r].first}, {"to_deg", rings[r].second},
@@ -477,9 +486,12 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
                     {"width", rig.width}, {"height", rig.height}, {"frame_ms", cell.frameMs}, {"eye_pass_ms", eyeMs},
                     {"reconstruct_ms", cell.reconstructMs}, {"samples_per_eye", samples}, {"pixels_per_eye", pixels},
                     {"eye_pass_speedup", fullEyeMs / std::max(eyeMs, 1e-9)}, {"rings", ringJson},
+                    {"stereo", stereoModeName(columns[c].stereo)}, {"right_left_ratio", rightLeft},
+                    {"reused_vertex_fraction", reusedShare},
                     {"check", ok ? "ok" : "MISMATCH"}});
     std::fflush(stdout);
   }
+  if (!reuseNotes.empty()) std::printf("\n%s", reuseNotes.c_str());
   return failures + runFlicker(args, scene, renderer, rig, linear, reference.eyes[0].image, json);
 }
 

@@ -52,7 +52,6 @@ expect_error "--gaze must be" render cornell --foveated --gaze 0.5 --eye-size 8x
 expect_error "cannot open mask file" render cornell --foveated --mask "$data/missing.pvrmask" --eye-size 8x8
 expect_error "not a photonvr mask" render cornell --foveated --mask "$data/box.obj" --eye-size 8x8
 expect_error "only for\|is for --foveated" render cornell --mask "$data/box.obj" --eye-size 8x8
-expect_error "not implemented yet" render cornell --foveated --stereo gather --eye-size 16x16
 "$exe" mask --eye-size 32x32 --out "$out/m32.pvrmask" >/dev/null 2>&1
 expect_error "mask is for 32x32" render cornell --foveated --mask "$out/m32.pvrmask" --eye-size 16x16
 expect_error "cannot open trajectory" render cornell --trajectory "$data/missing.txt" --eye-size 8x8

@@ -221,6 +221,19 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
       EXPECT_TRUE(a.eyes[e].firstPrim.empty() && b.eyes[e].firstPrim.empty()) << "foveated frames have no first-hit ids";
     }
   }
+  // Stereo reuse per vertex: the right eye takes as many of the left's vertices as on the CPU.
+  for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
+    RenderOptions o;
+    o.photonsX = o.photonsY = 128;
+    o.gather.density.radius = 0.08f;
+    o.foveation.mask = &mask;
+    o.stereo = mode;
+    FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
+    EXPECT_GT(a.reusedPixels, a.shadedSamples[1] / 4) << stereoModeName(mode);
+    EXPECT_NEAR(double(a.reusedPixels), double(b.reusedPixels), 0.005 * double(a.shadedSamples[1])) << stereoModeName(mode);
+    for (int e = 0; e < 2; ++e)
+      EXPECT_LT(relativeDifference(a.eyes[e].image, b.eyes[e].image), 0.01) << stereoModeName(mode) << " eye " << e;
+  }
 }
 
 // TAA over a few frames of head motion and a moving gaze, full resolution and foveated: the

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "pvr/foveation/mask.h"
 #include "pvr/render/image_compare.h"
 #include "pvr/render/renderer.h"
 #include "pvr/util/error.h"
@@ -234,6 +235,54 @@ TEST(StereoReuse, GatherIsInvisibleOnTheCornellBox) {
   // The left eye is never affected by reuse.
   for (size_t i = 0; i < separate.eyes[0].image.pixels.size(); ++i)
     ASSERT_EQ(gather.eyes[0].image.pixels[i].x, separate.eyes[0].image.pixels[i].x);
+}
+
+// Foveated eyes reuse per mask vertex: a right vertex on a pixel centre (the whole full-density
+// region) may take the shading of the left pixel that a left vertex recorded.
+TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
+  Scene scene = builtinScene("cornell");
+  CpuBackend backend(scene);
+  StereoRig rig = smallRig(scene);
+  MaskParams params = maskParamsForRig(rig);
+  params.tanPerPixel *= 9.0f;  // a coarse pixel: the headset's falloff on a small image
+  params.acuity.gazeMarginDeg = 3.0f;
+  FoveationMask mask = generateFoveationMask(params);
+  for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
+    SCOPED_TRACE(stereoModeName(mode));
+    RenderOptions o = stereoOptions(mode, ShadingMode::PhotonMapOnly);
+    o.foveation.mask = &mask;
+    RenderOptions separateOptions = o;
+    separateOptions.stereo = StereoMode::Separate;
+    FrameResult reused = renderFrame(backend, rig, o), separate = renderFrame(backend, rig, separateOptions);
+    // The candidates: right vertices on pixel centres that see a surface (all diffuse here).
+    int gx, gy;
+    o.foveation.gazePixel(1, rig.width, rig.height, gx, gy);
+    std::vector<uint8_t> inUse = verticesInUse(mask, gx, gy);
+    size_t candidates = 0;
+    for (size_t v = 0; v < inUse.size(); ++v) {
+      float px = mask.offsets[v].x + float(gx), py = mask.offsets[v].y + float(gy);
+      if (!inUse[v] || px != std::floor(px) || py != std::floor(py) || px < 0 || py < 0 || px >= rig.width || py >= rig.height)
+        continue;
+      candidates += separate.eyes[1].inverseDepth[size_t(py) * rig.width + size_t(px)] > 0.0f ? 1 : 0;
+    }
+    ASSERT_GT(candidates, 200u);
+    // Only where the two full-density regions overlap on the scene: on this coarse mask they are
+    // ~8 pixels wide, and the same gaze fraction in both eyes points ~4 deg apart (asymmetric
+    // FOVs) before parallax.
+    EXPECT_GT(double(reused.reusedPixels), 0.25 * double(candidates));
+    EXPECT_LE(reused.reusedPixels, candidates);
+    EXPECT_EQ(reused.shadedSamples[1], separate.shadedSamples[1]);
+    EXPECT_TRUE(reused.eyes[1].reusedFrom.empty()) << "foveated reuse is per vertex";
+    EXPECT_GE(compareDisplayed(reused.eyes[1].image, separate.eyes[1].image).psnr, 40.0);
+    EXPECT_EQ(compareDisplayed(reused.eyes[0].image, separate.eyes[0].image).meanSquaredError, 0.0) << "the left eye is unaffected";
+    // IPD 0 with equal FOVs and gazes: every vertex the right eye takes is the left one's own
+    // value at the same position, so the right image is the left image.
+    StereoRig same = smallRig(scene, 0.0f);
+    same.fov[1] = same.fov[0];
+    FrameResult one = renderFrame(backend, same, o);
+    EXPECT_GE(double(one.reusedPixels), 0.99 * double(candidates));
+    EXPECT_EQ(compareDisplayed(one.eyes[1].image, one.eyes[0].image).meanSquaredError, 0.0);
+  }
 }
 
 TEST(StereoReuse, ReuseNeedsBothEyes) {

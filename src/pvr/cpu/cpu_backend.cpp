@@ -55,7 +55,8 @@ void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams&
 
 template <class Map>
 size_t CpuBackend::renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                                         const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const {
+                                         const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
+                                         const StereoReuseView& reuse, SurfaceRecord* surfaces, size_t* reused) const {
   SceneView view = scene_.view();
   std::vector<uint8_t> used = verticesInUse(mask, gazeX, gazeY);
   std::vector<uint32_t> vertices;
@@ -63,29 +64,38 @@ size_t CpuBackend::renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const
     if (used[i]) vertices.push_back(i);
   std::vector<Vec3> colours(mask.offsets.size());
   std::vector<float> inverseDepths(mask.offsets.size(), 0.0f);
+  std::atomic<size_t> reusedVertices{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    size_t reusedHere = 0;
     for (size_t k = r.begin(); k < r.end(); ++k) {
       const uint32_t v = vertices[k];
       const MaskPoint& o = mask.offsets[v];
-      GatherPoint point = imagePositionGatherPoint(view, intersector_, params, camera, eye, o.x + float(gazeX) + 0.5f,
-                                                   o.y + float(gazeY) + 0.5f, &inverseDepths[v]);
+      PixelSample sample;
+      GatherPoint point = vertexGatherPoint(view, intersector_, params, camera, eye, o.x + float(gazeX) + 0.5f,
+                                            o.y + float(gazeY) + 0.5f, reuse, sample, surfaces);
       colours[v] = finishGather(map, point, params.density);
+      inverseDepths[v] = sample.inverseDepth;
+      reusedHere += sample.reusedFrom != kNotReused ? 1 : 0;
     }
+    reusedVertices += reusedHere;
   });
   reconstructFoveatedEye(mask, gazeX, gazeY, colours, inverseDepths, out);
   out.firstPrim.clear();
+  if (reused) *reused = reusedVertices;
   return vertices.size();
 }
 
 size_t CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params,
                                      const HashGridView& map, const FoveationMask& mask, int gazeX, int gazeY,
-                                     EyeResult& out) const {
-  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out);
+                                     EyeResult& out, const StereoReuseView& reuse, SurfaceRecord* surfaces,
+                                     size_t* reused) const {
+  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out, reuse, surfaces, reused);
 }
 
 size_t CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                                     const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const {
-  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out);
+                                     const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
+                                     const StereoReuseView& reuse, SurfaceRecord* surfaces, size_t* reused) const {
+  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out, reuse, surfaces, reused);
 }
 
 void CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target,

@@ -31,10 +31,16 @@ class CpuBackend {
 
   // Foveated: shades the mask's vertices in use for the gaze pixel (gazeX, gazeY) and reconstructs
   // the eye's image, depth and sample spacing from them into `out`; returns the vertices shaded.
+  // Vertices on pixel centres take the other eye's shading where `reuse` allows (counted in
+  // `reused`) and record their surfaces in `surfaces` (per pixel) if given.
   size_t renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
-                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const;
+                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
+                           const StereoReuseView& reuse = StereoReuseView(), SurfaceRecord* surfaces = nullptr,
+                           size_t* reused = nullptr) const;
   size_t renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const;
+                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
+                           const StereoReuseView& reuse = StereoReuseView(), SurfaceRecord* surfaces = nullptr,
+                           size_t* reused = nullptr) const;
 
   // Scatter: projects every reusable source pixel's surface into `target`'s image, keeping the
   // nearest per target pixel in `scattered` (width * height entries, filled with kNothingScattered
@@ -47,7 +53,8 @@ class CpuBackend {
  private:
   template <class Map>
   size_t renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                               const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out) const;
+                               const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
+                               const StereoReuseView& reuse, SurfaceRecord* surfaces, size_t* reused) const;
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
                      PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const;

@@ -48,23 +48,8 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
   }
   frame.timings.mapBuildMs = msSince(start);
 
-  if (const FoveationMask* mask = options.foveation.mask) {
-    checkMaskFits(*mask, rig.width, rig.height);
-    for (int e = 0; e < 2; ++e) {
-      if (!options.eyes[e]) continue;
-      int gx, gy;
-      options.foveation.gazePixel(e, rig.width, rig.height, gx, gy);
-      start = std::chrono::steady_clock::now();
-      EyeCamera camera = rig.eye(Eye(e));
-      frame.shadedSamples[e] =
-          options.map == PhotonMapKind::HashGrid
-              ? backend.renderFoveatedEye(camera, Eye(e), options.gather, grid.view(), *mask, gx, gy, frame.eyes[e])
-              : backend.renderFoveatedEye(camera, Eye(e), options.gather, tree.view(), *mask, gx, gy, frame.eyes[e]);
-      frame.timings.eyeMs[e] = frame.timings.eyeRayMs[e] = msSince(start);
-    }
-    return frame;
-  }
-
+  const FoveationMask* mask = options.foveation.mask;
+  if (mask) checkMaskFits(*mask, rig.width, rig.height);
   // The left eye first: under stereo reuse the right eye reads its surfaces and finished image.
   const bool reusing = options.stereo != StereoMode::Separate;
   std::vector<PixelSample> samples;
@@ -73,10 +58,10 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;
     EyeCamera camera = rig.eye(Eye(e));
-    samples.assign(size_t(camera.width) * camera.height, PixelSample());
+    const size_t pixels = size_t(camera.width) * camera.height;
     EyeResult& out = frame.eyes[e];
     StereoReuseView reuse;
-    if (reusing && e == 0) leftSurfaces.resize(samples.size());
+    if (reusing && e == 0) leftSurfaces.assign(pixels, SurfaceRecord());  // foveated: only vertices' pixels are written
     if (reusing && e == 1) {
       reuse.mode = options.stereo;
       reuse.source = rig.eye(Eye::Left);
@@ -86,11 +71,28 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
     SurfaceRecord* surfaces = reusing && e == 0 ? leftSurfaces.data() : nullptr;
     start = std::chrono::steady_clock::now();
     if (reuse.mode == StereoMode::Scatter) {
-      scattered.resize(samples.size());
+      scattered.resize(pixels);
       backend.scatter(leftSurfaces.data(), leftSurfaces.size(), camera, scattered.data());
       reuse.scattered = scattered.data();
       frame.timings.scatterMs = msSince(start);
     }
+    if (mask) {
+      auto eyeStart = std::chrono::steady_clock::now();
+      int gx, gy;
+      options.foveation.gazePixel(e, rig.width, rig.height, gx, gy);
+      size_t reused = 0;
+      frame.shadedSamples[e] =
+          options.map == PhotonMapKind::HashGrid
+              ? backend.renderFoveatedEye(camera, Eye(e), options.gather, grid.view(), *mask, gx, gy, out, reuse,
+                                          surfaces, &reused)
+              : backend.renderFoveatedEye(camera, Eye(e), options.gather, tree.view(), *mask, gx, gy, out, reuse,
+                                          surfaces, &reused);
+      frame.reusedPixels += reused;
+      frame.timings.eyeRayMs[e] = msSince(eyeStart);
+      frame.timings.eyeMs[e] = msSince(start);
+      continue;
+    }
+    samples.assign(pixels, PixelSample());
     auto eyeStart = std::chrono::steady_clock::now();
     if (options.map == PhotonMapKind::HashGrid)
       backend.renderEye(camera, Eye(e), options.gather, grid.view(), samples.data(), reuse, surfaces);

@@ -185,7 +185,7 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
         PVR_CUDA_CHECK(cudaMemcpyAsync(out.firstPrim.data(), m.gather.firstPrim(Eye(e)), pixels * sizeof(uint32_t),
                                        cudaMemcpyDeviceToHost, m.stream));
       }
-      if (e == 1 && options.stereo != StereoMode::Separate) {
+      if (e == 1 && options.stereo != StereoMode::Separate && !options.foveation.mask) {
         out.reusedFrom.resize(pixels);
         PVR_CUDA_CHECK(cudaMemcpyAsync(out.reusedFrom.data(), m.gather.reusedFrom(), out.reusedFrom.size() * sizeof(uint32_t),
                                        cudaMemcpyDeviceToHost, m.stream));

@@ -115,4 +115,15 @@ int multiprocessorCount();
 
 inline unsigned blocksFor(size_t n, unsigned threads) { return unsigned((n + threads - 1) / threads); }
 
+#ifdef __CUDACC__
+// Adds the number of the calling warp's active threads whose `flag` is set to *counter: one atomic
+// per warp, not per thread.
+__device__ inline void countInWarp(unsigned* counter, bool flag) {
+  unsigned active = __activemask();
+  unsigned set = __ballot_sync(active, flag);
+  unsigned lane = (threadIdx.z * blockDim.y * blockDim.x + threadIdx.y * blockDim.x + threadIdx.x) & 31u;
+  if (lane == unsigned(__ffs(int(active)) - 1) && set) atomicAdd(counter, unsigned(__popc(int(set))));
+}
+#endif
+
 }  // namespace pvr::cuda

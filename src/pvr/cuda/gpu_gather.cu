@@ -34,10 +34,7 @@ __device__ inline void recordPixel(const EyeOutputs& out, size_t pixel, const Pi
   out.inverseDepth[pixel] = p.inverseDepth;
   if (!out.reusedFrom) return;
   out.reusedFrom[pixel] = p.reusedFrom;
-  unsigned active = __activemask();
-  unsigned reused = __ballot_sync(active, p.reusedFrom != kNotReused);
-  unsigned lane = (threadIdx.y * blockDim.x + threadIdx.x) & 31u;
-  if (lane == unsigned(__ffs(int(active)) - 1) && reused) atomicAdd(out.reusedCount, unsigned(__popc(int(reused))));
+  countInWarp(out.reusedCount, p.reusedFrom != kNotReused);
 }
 
 // An eye's part in stereo reuse, a compile-time kernel parameter: the reuse code paths cost
@@ -221,6 +218,10 @@ __global__ void warpPerPointDensityKernel(HashGridView map, float radius, const 
   for (uint32_t i = (blockIdx.x * blockDim.x + threadIdx.x) >> 5; i < n; i += warps) {  // warp-uniform
     uint32_t pixel = list[i];
     GatherPoint gp = points[pixel];
+    if (!gp.needsEstimate()) {  // a reused vertex: the other eye's colour
+      if (lane == 0) storeSample(image, pixel, gp.radiance, sample, samples);
+      continue;
+    }
     Vec3 sum{0, 0, 0};
     int64_t cell = map.photonCount ? map.cellOf(gp.position) : -1;
     for (int row = 0; cell >= 0 && row < 9; ++row) {
@@ -258,17 +259,21 @@ struct VertexInUse {
 };
 
 // Eye rays through the listed vertices, to their gather points (indexed by vertex).
+// Foveated: the listed vertices' eye rays (on pixel centres: with stereo reuse, and recording
+// surfaces for the other eye where `surfaces` is set; reused vertices counted in `reusedCount`).
 __global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
                                  Eye eye, DeviceMaskView mask, int gazeX, int gazeY, const uint32_t* list,
-                                 const uint32_t* listed, GatherPoint* points, float* inverseDepths) {
+                                 const uint32_t* listed, StereoReuseView reuse, SurfaceRecord* surfaces,
+                                 unsigned* reusedCount, GatherPoint* points, float* inverseDepths) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= *listed) return;
   uint32_t vertex = list[i];
   MaskPoint o = mask.offsets[vertex];
-  float inverseDepth;
-  points[vertex] = imagePositionGatherPoint(scene, intersector, params, camera, eye, o.x + float(gazeX) + 0.5f,
-                                            o.y + float(gazeY) + 0.5f, &inverseDepth);
-  inverseDepths[vertex] = inverseDepth;
+  PixelSample sample;
+  points[vertex] = vertexGatherPoint(scene, intersector, params, camera, eye, o.x + float(gazeX) + 0.5f,
+                                     o.y + float(gazeY) + 0.5f, reuse, sample, surfaces);
+  inverseDepths[vertex] = sample.inverseDepth;
+  if (reusedCount) countInWarp(reusedCount, sample.reusedFrom != kNotReused);
 }
 
 // One thread per listed gather point (kNN, or the kd-tree).
@@ -373,6 +378,34 @@ void dispatchSingle(const DeviceScene& scene, DeviceMap map, const GatherParams&
 
 }  // namespace
 
+StereoReuseView GpuGather::prepareReuse(const RenderOptions& options, const StereoRig& rig, Eye eye,
+                                        cudaStream_t stream, EyeOutputs& out) {
+  StereoReuseView reuse;
+  if (options.stereo == StereoMode::Separate) return reuse;
+  const size_t pixels = size_t(rig.width) * rig.height;
+  if (eye == Eye::Left) {
+    surfaces_.reserve(pixels, "left-eye surfaces");
+    // Foveated, only the vertices' pixels are recorded: the rest must read as not reusable.
+    if (options.foveation.mask)
+      PVR_CUDA_CHECK(cudaMemsetAsync(surfaces_.data(), 0xff, pixels * sizeof(SurfaceRecord), stream));
+    out.surfaces = surfaces_.data();
+    return reuse;
+  }
+  reuse.mode = options.stereo;
+  reuse.source = rig.eye(Eye::Left);
+  reuse.sourceSurfaces = surfaces_.data();
+  reuse.sourceImage = images_[int(Eye::Left)].data();
+  reuse.scattered = options.stereo == StereoMode::Scatter ? scattered_.data() : nullptr;
+  reusedCount_.reserve(1, "reuse count");
+  PVR_CUDA_CHECK(cudaMemsetAsync(reusedCount_.data(), 0, sizeof(unsigned), stream));
+  out.reusedCount = reusedCount_.data();
+  if (!options.foveation.mask) {  // foveated reuse is per vertex: no per-pixel sources
+    reusedFrom_.reserve(pixels, "reuse sources");
+    out.reusedFrom = reusedFrom_.data();
+  }
+  return reuse;
+}
+
 size_t GpuGather::memoryBytes() const {
   size_t bytes = points_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
                  reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
@@ -409,22 +442,7 @@ void GpuGather::renderEye(const DeviceScene& scene, DeviceMap map, const RenderO
   out.image = image;
   out.firstPrim = (firstPrim_[int(eye)].reserve(pixels, "first-hit ids"), firstPrim_[int(eye)].data());
   out.inverseDepth = (inverseDepth_[int(eye)].reserve(pixels, "eye depths"), inverseDepth_[int(eye)].data());
-  StereoReuseView reuse;
-  if (options.stereo != StereoMode::Separate && eye == Eye::Left) {
-    surfaces_.reserve(pixels, "left-eye surfaces");
-    out.surfaces = surfaces_.data();
-  } else if (options.stereo != StereoMode::Separate) {
-    reuse.mode = options.stereo;
-    reuse.source = rig.eye(Eye::Left);
-    reuse.sourceSurfaces = surfaces_.data();
-    reuse.sourceImage = images_[int(Eye::Left)].data();
-    reuse.scattered = options.stereo == StereoMode::Scatter ? scattered_.data() : nullptr;
-    reusedFrom_.reserve(pixels, "reuse sources");
-    reusedCount_.reserve(1, "reuse count");
-    PVR_CUDA_CHECK(cudaMemsetAsync(reusedCount_.data(), 0, sizeof(unsigned), stream));
-    out.reusedFrom = reusedFrom_.data();
-    out.reusedCount = reusedCount_.data();
-  }
+  StereoReuseView reuse = prepareReuse(options, rig, eye, stream, out);
 
   if (options.kernel == DensityKernel::Single) {  // shadePixel loops over the samples itself
     timers.prepare(1);
@@ -537,6 +555,8 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
   vertexColours_.reserve(mask.vertexCount, "mask vertex colours");
   vertexInverseDepths_.reserve(mask.vertexCount, "mask vertex depths");
   uint32_t* count = vertexCount_.data() + int(eye);
+  EyeOutputs out;
+  const StereoReuseView reuse = prepareReuse(options, rig, eye, stream, out);
   size_t bytes = 0;
   thrust::counting_iterator<uint32_t> vertices(0);
   PVR_CUDA_CHECK(cub::DeviceSelect::If(nullptr, bytes, vertices, vertexList_.data(), count, int(mask.vertexCount),
@@ -554,8 +574,8 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
                                        VertexInUse{vertexUsed_.data()}, stream));
   vertexRaysKernel<<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(scene.view, scene.intersector, params, camera,
                                                                          eye, mask, gazeX, gazeY, vertexList_.data(),
-                                                                         count, vertexPoints_.data(),
-                                                                         vertexInverseDepths_.data());
+                                                                         count, reuse, out.surfaces, out.reusedCount,
+                                                                         vertexPoints_.data(), vertexInverseDepths_.data());
   PVR_CUDA_CHECK_LAUNCH("vertexRays");
   timers.rays[0]->stop(stream);
 

@@ -84,6 +84,11 @@ class GpuGather {
   size_t memoryBytes() const;
 
  private:
+  // Sets up `eye`'s part in stereo reuse (options.stereo): the left eye's surface records in
+  // `out`, or the right eye's view of them, with its reuse outputs in `out`.
+  StereoReuseView prepareReuse(const RenderOptions& options, const StereoRig& rig, Eye eye, cudaStream_t stream,
+                               EyeOutputs& out);
+
   DeviceBuffer<Vec3> images_[2];
   DeviceBuffer<uint32_t> firstPrim_[2];
   DeviceBuffer<float> inverseDepth_[2], sampleSpacing_[2];

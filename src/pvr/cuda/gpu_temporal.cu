@@ -5,14 +5,13 @@ namespace {
 
 constexpr int kBlock = 16;
 
-// One thread per pixel; the pixels that took history are counted per warp (one atomic each).
+// One thread per pixel; the pixels that took history are counted per warp.
 __global__ void resolveKernel(TaaView view, Vec3* out, unsigned* historyPixels) {
   int x = int(blockIdx.x) * kBlock + int(threadIdx.x), y = int(blockIdx.y) * kBlock + int(threadIdx.y);
   bool usedHistory = false;
   if (x < view.camera.width && y < view.camera.height)
     out[size_t(y) * view.camera.width + x] = resolveTemporalPixel(view, x, y, usedHistory);
-  unsigned used = __ballot_sync(0xffffffffu, usedHistory);
-  if (((threadIdx.y * kBlock + threadIdx.x) & 31u) == 0 && used) atomicAdd(historyPixels, unsigned(__popc(int(used))));
+  countInWarp(historyPixels, usedHistory);
 }
 
 }  // namespace

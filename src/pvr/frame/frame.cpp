@@ -71,8 +71,6 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
     for (int e = 0; e < 2; ++e)
       for (float g : o.foveation.gaze[e])
         if (!(g >= 0.0f && g <= 1.0f)) throw Error("the gaze must lie in the image: coordinates between 0 and 1");
-    if (o.stereo != StereoMode::Separate)
-      throw Error("foveated rendering with stereo reuse is not implemented yet: use --stereo separate");
   }
   if (o.temporal.enabled) {
     const TaaParams& t = o.temporal.taa;

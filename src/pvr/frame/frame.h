@@ -99,7 +99,7 @@ struct EyeResult {
   /// Foveated: per pixel, the spacing in pixels of the samples it was rebuilt from. Empty: 1.
   std::vector<float> sampleSpacing;
   /// The right eye under stereo reuse: per pixel, the left pixel whose shading it took
-  /// (kNotReused: shaded here). Empty otherwise.
+  /// (kNotReused: shaded here). Empty otherwise, and for foveated frames (reuse is per vertex).
   std::vector<uint32_t> reusedFrom;
 };
 
@@ -109,7 +109,7 @@ struct FrameResult {
   size_t storedPhotons = 0;
   size_t mapBytes = 0;
   size_t deviceBytes = 0;  ///< GPU memory held by the backend (0 on the CPU)
-  size_t reusedPixels = 0;  ///< right-eye pixels that took the left eye's shading
+  size_t reusedPixels = 0;  ///< right-eye pixels (mask vertices when foveated) that took the left eye's shading
   size_t shadedSamples[2] = {0, 0};  ///< per eye: pixels, or mask vertices when foveated
   size_t historyPixels[2] = {0, 0};  ///< TAA: per eye, pixels that blended in their history
 };

@@ -197,6 +197,25 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   return traceToDiffuse(scene, intersector, params, ray, rng, &first);
 }
 
+// A foveation mask vertex at image position (px, py). On a pixel centre (all of the mask's
+// full-density part) it is that pixel's first sample, with the same random numbers, stereo reuse
+// (`reuse`), and its surface record written to `surfaces` (per pixel: the eye another one reuses)
+// if given. Elsewhere it is shaded on its own. `sample` receives the first hit's inverse depth and
+// the reuse decision.
+template <class Intersector>
+PVR_HOST_DEVICE GatherPoint vertexGatherPoint(const SceneView& scene, const Intersector& intersector,
+                                              const GatherParams& params, const EyeCamera& camera, Eye eye, float px,
+                                              float py, const StereoReuseView& reuse, PixelSample& sample,
+                                              SurfaceRecord* surfaces = nullptr) {
+  const float fx = floorf(px), fy = floorf(py);
+  if (px - fx == 0.5f && py - fy == 0.5f && camera.containsPixel(px, py)) {
+    const int x = int(fx), y = int(fy);
+    return pixelGatherPoint(scene, intersector, params, camera, eye, x, y, 0, reuse, sample,
+                            surfaces ? surfaces + size_t(y) * camera.width + x : nullptr);
+  }
+  return imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, &sample.inverseDepth);
+}
+
 // Pixel (x, y) of one eye: the average of samplesPerPixel jittered rays, or the other eye's
 // colour where `reuse` finds the same surface point.
 template <class Intersector, class PhotonMap>
