@@ -363,7 +363,8 @@ int runFlicker(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& re
       double angle = 2.0 * kPi * double(f) / periodFrames;
       float gx = 0.5f + 0.1f * float(std::cos(angle));
       float gy = 0.5f + 0.1f * float(std::sin(angle)) * float(rig.width) / float(rig.height);
-      for (auto& g : o.foveation.gaze) g[0] = gx, g[1] = gy;
+      o.foveation.gaze[0][0] = gx, o.foveation.gaze[0][1] = gy;
+      o.foveation.verge = true;
       FrameResult frame = renderer.render(rig, o, true);
       const Image& shown = frame.eyes[0].image;
       if (f >= warmup) {
@@ -444,7 +445,8 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
     o.gather.density.radius = 0.05f;
     o.foveation.mask = columns[c].mask;
     o.stereo = columns[c].stereo;
-    for (auto& g : o.foveation.gaze) g[0] = columns[c].gazeX, g[1] = columns[c].gazeY;
+    o.foveation.gaze[0][0] = columns[c].gazeX, o.foveation.gaze[0][1] = columns[c].gazeY;
+    o.foveation.verge = true;  // both eyes fixate one point
     CellResult cell = timeCell(renderer, rig, o, args.warmup, args.frames);
     double eyeMs = cell.eyeMs[0] + cell.eyeMs[1];
     if (c == 0) fullEyeMs = eyeMs, reference = cell.last;

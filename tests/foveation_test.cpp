@@ -246,5 +246,41 @@ TEST(FoveatedRender, TheFoveaIsTheFullResolutionImageAndFewerSamplesAreShaded) {
   EXPECT_THROW(renderFrame(backend, rig, o), Error);
 }
 
+// With one gaze for both eyes, the right eye looks at the surface point the left eye fixates.
+TEST(FoveatedRender, VergedEyesFixateTheSamePoint) {
+  Scene scene = builtinScene("cornell");
+  CpuBackend backend(scene);
+  StereoRig rig = scene.rig;
+  rig.width = 160, rig.height = 176;
+  rig.ipd = 0.2f;  // a wide baseline: a large disparity
+  MaskParams params = maskParamsForRig(rig);
+  params.acuity = smallParams().acuity;
+  FoveationMask mask = generateFoveationMask(params);
+  RenderOptions o;
+  o.photonsX = o.photonsY = 32;
+  o.foveation.mask = &mask;
+  o.foveation.verge = true;
+  for (float gx : {0.3f, 0.5f, 0.62f}) {
+    o.foveation.gaze[0][0] = gx, o.foveation.gaze[0][1] = 0.55f;
+    FrameResult frame = renderFrame(backend, rig, o);
+    EXPECT_EQ(frame.gaze[0][0], gx);
+    Vec3 fixated[2];
+    for (int e = 0; e < 2; ++e) {
+      FoveationOptions f;
+      std::copy(frame.gaze[e], frame.gaze[e] + 2, f.gaze[e]);
+      int x, y;
+      f.gazePixel(e, rig.width, rig.height, x, y);
+      Ray ray = rig.eye(Eye(e)).generateRay(x + 0.5f, y + 0.5f);
+      Hit hit;
+      ASSERT_TRUE(backend.intersector().intersect(ray, INFINITY, hit));
+      fixated[e] = ray.origin + ray.dir * hit.t;
+    }
+    // Within two pixels' width on the surface (the right gaze is rounded to a pixel).
+    float pixel = length(fixated[0] - rig.eye(Eye::Left).pose.position) * params.tanPerPixel;
+    EXPECT_LT(length(fixated[0] - fixated[1]), 2.0f * pixel) << "gaze x " << gx;
+    EXPECT_GT(std::fabs(frame.gaze[1][0] - gx), 0.02f) << "the disparity moves the right eye's gaze";
+  }
+}
+
 }  // namespace
 }  // namespace pvr

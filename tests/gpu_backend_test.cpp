@@ -221,15 +221,20 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
       EXPECT_TRUE(a.eyes[e].firstPrim.empty() && b.eyes[e].firstPrim.empty()) << "foveated frames have no first-hit ids";
     }
   }
-  // Stereo reuse per vertex: the right eye takes as many of the left's vertices as on the CPU.
+  // Stereo reuse per vertex, with the eyes verged on one point: the right eye's gaze and the
+  // vertices it takes from the left agree with the CPU's.
   for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
     RenderOptions o;
     o.photonsX = o.photonsY = 128;
     o.gather.density.radius = 0.08f;
     o.foveation.mask = &mask;
+    o.foveation.gaze[0][0] = 0.4f, o.foveation.gaze[0][1] = 0.55f;
+    o.foveation.verge = true;
     o.stereo = mode;
     FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
-    EXPECT_GT(a.reusedPixels, a.shadedSamples[1] / 4) << stereoModeName(mode);
+    EXPECT_NEAR(a.gaze[1][0], b.gaze[1][0], 1.0f / rig.width) << stereoModeName(mode);
+    EXPECT_NEAR(a.gaze[1][1], b.gaze[1][1], 1.0f / rig.height) << stereoModeName(mode);
+    EXPECT_GT(a.reusedPixels, a.shadedSamples[1] / 2) << stereoModeName(mode);
     EXPECT_NEAR(double(a.reusedPixels), double(b.reusedPixels), 0.005 * double(a.shadedSamples[1])) << stereoModeName(mode);
     for (int e = 0; e < 2; ++e)
       EXPECT_LT(relativeDifference(a.eyes[e].image, b.eyes[e].image), 0.01) << stereoModeName(mode) << " eye " << e;

@@ -255,16 +255,22 @@ TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
     separateOptions.stereo = StereoMode::Separate;
     FrameResult reused = renderFrame(backend, rig, o), separate = renderFrame(backend, rig, separateOptions);
     // The candidates: right vertices on pixel centres that see a surface (all diffuse here).
-    int gx, gy;
-    o.foveation.gazePixel(1, rig.width, rig.height, gx, gy);
-    std::vector<uint8_t> inUse = verticesInUse(mask, gx, gy);
-    size_t candidates = 0;
-    for (size_t v = 0; v < inUse.size(); ++v) {
-      float px = mask.offsets[v].x + float(gx), py = mask.offsets[v].y + float(gy);
-      if (!inUse[v] || px != std::floor(px) || py != std::floor(py) || px < 0 || py < 0 || px >= rig.width || py >= rig.height)
-        continue;
-      candidates += separate.eyes[1].inverseDepth[size_t(py) * rig.width + size_t(px)] > 0.0f ? 1 : 0;
-    }
+    auto candidatesOf = [&](const FrameResult& frame) {
+      FoveationOptions f;
+      std::copy(frame.gaze[1], frame.gaze[1] + 2, f.gaze[1]);
+      int gx, gy;
+      f.gazePixel(1, rig.width, rig.height, gx, gy);
+      std::vector<uint8_t> inUse = verticesInUse(mask, gx, gy);
+      size_t n = 0;
+      for (size_t v = 0; v < inUse.size(); ++v) {
+        float px = mask.offsets[v].x + float(gx), py = mask.offsets[v].y + float(gy);
+        if (inUse[v] && px == std::floor(px) && py == std::floor(py) && px >= 0 && py >= 0 && px < rig.width &&
+            py < rig.height)
+          n += frame.eyes[1].inverseDepth[size_t(py) * rig.width + size_t(px)] > 0.0f ? 1 : 0;
+      }
+      return n;
+    };
+    const size_t candidates = candidatesOf(reused);
     ASSERT_GT(candidates, 200u);
     // Only where the two full-density regions overlap on the scene: on this coarse mask they are
     // ~8 pixels wide, and the same gaze fraction in both eyes points ~4 deg apart (asymmetric
@@ -275,6 +281,12 @@ TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
     EXPECT_TRUE(reused.eyes[1].reusedFrom.empty()) << "foveated reuse is per vertex";
     EXPECT_GE(compareDisplayed(reused.eyes[1].image, separate.eyes[1].image).psnr, 40.0);
     EXPECT_EQ(compareDisplayed(reused.eyes[0].image, separate.eyes[0].image).meanSquaredError, 0.0) << "the left eye is unaffected";
+    // Eyes that fixate one point (vergence) share most of their full-density regions.
+    o.foveation.verge = true;
+    FrameResult verged = renderFrame(backend, rig, o);
+    EXPECT_GT(double(verged.reusedPixels), 0.8 * double(candidatesOf(verged)));
+    EXPECT_GT(verged.reusedPixels, 2 * reused.reusedPixels);
+    o.foveation.verge = false;
     // IPD 0 with equal FOVs and gazes: every vertex the right eye takes is the left one's own
     // value at the same position, so the right image is the left image.
     StereoRig same = smallRig(scene, 0.0f);

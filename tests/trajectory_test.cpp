@@ -31,6 +31,8 @@ TEST(Trajectory, ReadsPosesAndGazeOfBothForms) {
   EXPECT_FLOAT_EQ(frames[0].gaze[1][1], 0.75f);  // one gaze for both eyes
   EXPECT_FLOAT_EQ(frames[1].gaze[0][1], 0.2f);
   EXPECT_FLOAT_EQ(frames[1].gaze[1][0], 0.3f);
+  EXPECT_TRUE(frames[0].verge);
+  EXPECT_FALSE(frames[1].verge);
   Vec3 forward = frames[1].head.orientation.rotate({0, 0, -1});
   EXPECT_NEAR(forward.x, -1.0f, 1e-5f);  // 90 degrees about +Y turns -Z to -X
   std::filesystem::remove(path);

@@ -168,7 +168,8 @@ int runRender(const RenderArgs& a) {
     mask = a.mask.empty() ? generateFoveationMask(maskParamsForRig(rig)) : loadFoveationMask(a.mask);
     checkMaskFits(mask, rig.width, rig.height);
     options.foveation.mask = &mask;
-    for (auto& g : options.foveation.gaze) g[0] = gx, g[1] = gy;
+    options.foveation.gaze[0][0] = gx, options.foveation.gaze[0][1] = gy;
+    options.foveation.verge = true;  // both eyes fixate what the left eye's gaze meets
     validateOptions(options, rig);
   } else if (!a.mask.empty()) {
     throw Error("--mask is for --foveated rendering");
@@ -201,6 +202,7 @@ int runRender(const RenderArgs& a) {
     for (size_t f = 0; f < trajectory.size(); ++f) {
       rig.head = trajectory[f].head;
       std::copy(&trajectory[f].gaze[0][0], &trajectory[f].gaze[0][0] + 4, &options.foveation.gaze[0][0]);
+      options.foveation.verge = trajectory[f].verge;
       FrameResult frame = renderer->render(rig, options);
       totalMs += frame.timings.totalMs();
       char prefix[32];
@@ -245,6 +247,9 @@ int runRender(const RenderArgs& a) {
                 frame.shadedSamples[0], frame.shadedSamples[1],
                 2.0 * rig.width * rig.height / double(std::max<size_t>(frame.shadedSamples[0] + frame.shadedSamples[1], 1)),
                 mask.offsets.size());
+  if (options.foveation.mask)
+    std::printf("  gaze: left eye %.3f,%.3f, right eye %.3f,%.3f%s\n", frame.gaze[0][0], frame.gaze[0][1], frame.gaze[1][0],
+                frame.gaze[1][1], options.foveation.verge ? " (fixating the left eye's point)" : "");
   if (frame.deviceBytes) std::printf("  GPU memory    %9.1f MiB\n", frame.deviceBytes / 1048576.0);
   std::printf("  total         %9.2f ms\n", frame.timings.totalMs());
   for (int e = 0; e < 2; ++e) {
@@ -335,7 +340,7 @@ int runCli(int argc, char** argv) {
   render->add_flag("--foveated", ra.foveated,
                    "Foveated: shade only a foveation mask's vertices around the gaze and reconstruct");
   render->add_option("--mask", ra.mask, "Foveation mask file from `photonvr mask` (default: made for the rig at start)");
-  render->add_option("--gaze", ra.gaze, "Gaze point X,Y as fractions of the image (0.5,0.5 = centre)")
+  render->add_option("--gaze", ra.gaze, "Left eye's gaze point X,Y as fractions of the image (0.5,0.5 = centre); the right eye fixates the same surface point")
       ->capture_default_str();
   render->add_option("--trajectory", ra.trajectory,
                      "Render one frame per line of FILE: 'px py pz qx qy qz qw gx gy' (head pose; gaze as image "

@@ -50,6 +50,7 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
 
   const FoveationMask* mask = options.foveation.mask;
   if (mask) checkMaskFits(*mask, rig.width, rig.height);
+  FoveationOptions foveation = options.foveation;  // the right eye's gaze may follow the left's
   // The left eye first: under stereo reuse the right eye reads its surfaces and finished image.
   const bool reusing = options.stereo != StereoMode::Separate;
   std::vector<PixelSample> samples;
@@ -78,8 +79,13 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
     }
     if (mask) {
       auto eyeStart = std::chrono::steady_clock::now();
+      if (e == 1 && foveation.verge)
+        vergeRightGaze(rig, foveation,
+                       options.eyes[0] ? &frame.eyes[0].inverseDepth[foveation.gazePixelIndex(0, rig.width, rig.height)]
+                                       : nullptr);
+      std::copy(foveation.gaze[e], foveation.gaze[e] + 2, frame.gaze[e]);
       int gx, gy;
-      options.foveation.gazePixel(e, rig.width, rig.height, gx, gy);
+      foveation.gazePixel(e, rig.width, rig.height, gx, gy);
       size_t reused = 0;
       frame.shadedSamples[e] =
           options.map == PhotonMapKind::HashGrid

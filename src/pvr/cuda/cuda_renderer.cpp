@@ -113,6 +113,7 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
   }
 
   unsigned reused = 0;
+  RenderOptions eyeOptions = options;  // foveated: the right eye's gaze may follow the left's
   for (int e = 0; e < 2; ++e) {  // the left eye first: the right eye may reuse it
     if (!options.eyes[e]) continue;
     if (e == 1 && options.stereo == StereoMode::Scatter) {
@@ -120,11 +121,24 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
       m.gather.scatter(m.deviceScene, rig, m.stream);
       m.scatterTimer.stop(m.stream);
     }
-    if (options.foveation.mask)
-      m.gather.renderFoveatedEye(m.deviceScene, map, options, rig, Eye(e), mask, m.stream, m.eyeTimers[e],
+    if (options.foveation.mask) {
+      FoveationOptions& foveation = eyeOptions.foveation;
+      if (e == 1 && foveation.verge) {
+        float leftInverseDepth = 0;
+        if (options.eyes[0]) {  // the left eye's depth at its gaze: one value, waited for
+          PVR_CUDA_CHECK(cudaMemcpyAsync(&leftInverseDepth,
+                                         m.gather.inverseDepth(Eye::Left) + foveation.gazePixelIndex(0, rig.width, rig.height),
+                                         sizeof(float), cudaMemcpyDeviceToHost, m.stream));
+          PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+        }
+        vergeRightGaze(rig, foveation, options.eyes[0] ? &leftInverseDepth : nullptr);
+      }
+      std::copy(foveation.gaze[e], foveation.gaze[e] + 2, frame.gaze[e]);
+      m.gather.renderFoveatedEye(m.deviceScene, map, eyeOptions, rig, Eye(e), mask, m.stream, m.eyeTimers[e],
                                  m.reconstructTimer[e]);
-    else
+    } else {
       m.gather.renderEye(m.deviceScene, map, options, rig, Eye(e), m.stream, m.eyeTimers[e]);
+    }
     if (!options.temporal.enabled) {
       m.temporal.forget(Eye(e));
       continue;

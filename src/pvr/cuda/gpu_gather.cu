@@ -259,21 +259,28 @@ struct VertexInUse {
 };
 
 // Eye rays through the listed vertices, to their gather points (indexed by vertex).
-// Foveated: the listed vertices' eye rays (on pixel centres: with stereo reuse, and recording
-// surfaces for the other eye where `surfaces` is set; reused vertices counted in `reusedCount`).
+// Foveated: the listed vertices' eye rays. Under stereo reuse, those on pixel centres take the
+// pixel path: the left eye (Source) records their surfaces, the right (Reuser) may reuse them and
+// counts those it did. Separate rendering keeps the leaner per-position path (same result).
+template <StereoRole R>
 __global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
                                  Eye eye, DeviceMaskView mask, int gazeX, int gazeY, const uint32_t* list,
-                                 const uint32_t* listed, StereoReuseView reuse, SurfaceRecord* surfaces,
-                                 unsigned* reusedCount, GatherPoint* points, float* inverseDepths) {
+                                 const uint32_t* listed, StereoReuseView reuse, EyeOutputs out, GatherPoint* points,
+                                 float* inverseDepths) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= *listed) return;
   uint32_t vertex = list[i];
   MaskPoint o = mask.offsets[vertex];
-  PixelSample sample;
-  points[vertex] = vertexGatherPoint(scene, intersector, params, camera, eye, o.x + float(gazeX) + 0.5f,
-                                     o.y + float(gazeY) + 0.5f, reuse, sample, surfaces);
-  inverseDepths[vertex] = sample.inverseDepth;
-  if (reusedCount) countInWarp(reusedCount, sample.reusedFrom != kNotReused);
+  const float px = o.x + float(gazeX) + 0.5f, py = o.y + float(gazeY) + 0.5f;
+  if constexpr (R == StereoRole::Alone) {
+    points[vertex] = imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, inverseDepths + vertex);
+  } else {
+    PixelSample sample;
+    points[vertex] = vertexGatherPoint(scene, intersector, params, camera, eye, px, py, reuseFor<R>(reuse), sample,
+                                       R == StereoRole::Source ? out.surfaces : nullptr);
+    inverseDepths[vertex] = sample.inverseDepth;
+    if constexpr (R == StereoRole::Reuser) countInWarp(out.reusedCount, sample.reusedFrom != kNotReused);
+  }
 }
 
 // One thread per listed gather point (kNN, or the kd-tree).
@@ -572,10 +579,12 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
   bytes = temp_.capacity();
   PVR_CUDA_CHECK(cub::DeviceSelect::If(temp_.data(), bytes, vertices, vertexList_.data(), count, int(mask.vertexCount),
                                        VertexInUse{vertexUsed_.data()}, stream));
-  vertexRaysKernel<<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(scene.view, scene.intersector, params, camera,
-                                                                         eye, mask, gazeX, gazeY, vertexList_.data(),
-                                                                         count, reuse, out.surfaces, out.reusedCount,
-                                                                         vertexPoints_.data(), vertexInverseDepths_.data());
+  auto* vertexRays = out.reusedCount ? vertexRaysKernel<StereoRole::Reuser>
+                     : out.surfaces  ? vertexRaysKernel<StereoRole::Source>
+                                     : vertexRaysKernel<StereoRole::Alone>;
+  vertexRays<<<blocksFor(mask.vertexCount, 128), 128, 0, stream>>>(scene.view, scene.intersector, params, camera, eye,
+                                                                   mask, gazeX, gazeY, vertexList_.data(), count, reuse,
+                                                                   out, vertexPoints_.data(), vertexInverseDepths_.data());
   PVR_CUDA_CHECK_LAUNCH("vertexRays");
   timers.rays[0]->stop(stream);
 

@@ -36,6 +36,22 @@ StereoMode parseStereoMode(const std::string& text, const std::string& what) {
   throw Error(what + " must be separate, scatter or gather, got '" + text + "'");
 }
 
+void vergeRightGaze(const StereoRig& rig, FoveationOptions& foveation, const float* leftInverseDepthAtGaze) {
+  float* right = foveation.gaze[1];
+  right[0] = foveation.gaze[0][0], right[1] = foveation.gaze[0][1];
+  if (!leftInverseDepthAtGaze) return;
+  int gx, gy;
+  foveation.gazePixel(0, rig.width, rig.height, gx, gy);
+  const EyeCamera left = rig.eye(Eye::Left), rightEye = rig.eye(Eye::Right);
+  const float cx = float(gx) + 0.5f, cy = float(gy) + 0.5f, w = *leftInverseDepthAtGaze;
+  float px, py;
+  bool seen = w > 0.0f ? rightEye.project(left.pointAt(cx, cy, w), px, py)
+                       : rightEye.projectDirection(left.pose.toWorldDir(left.localDirection(cx, cy)), px, py);
+  if (!seen) return;
+  right[0] = std::clamp(px / float(rig.width), 0.0f, 1.0f);
+  right[1] = std::clamp(py / float(rig.height), 0.0f, 1.0f);
+}
+
 void setEyeSize(StereoRig& rig, const std::string& text) {
   static const std::regex size(R"(^\s*(\d{1,9})\s*[xX]\s*(\d{1,9})\s*$)");
   std::smatch m;

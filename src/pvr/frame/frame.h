@@ -21,10 +21,18 @@ struct FoveationMask;  // pvr/foveation/mask.h
 struct FoveationOptions {
   const FoveationMask* mask = nullptr;  ///< null: every pixel is shaded
   float gaze[2][2] = {{0.5f, 0.5f}, {0.5f, 0.5f}};  ///< per eye, gaze point in [0, 1]^2 of the image (x right, y down)
+  /// One gaze for both eyes, as eyes look: gaze[0] is the left eye's, and the right eye fixates
+  /// the surface point the left eye's gaze ray meets (vergence); gaze[1] is then ignored.
+  bool verge = false;
   // The gaze's pixel for an eye of width x height.
   void gazePixel(int eye, int width, int height, int& x, int& y) const {
     x = std::min(width - 1, std::max(0, int(gaze[eye][0] * float(width))));
     y = std::min(height - 1, std::max(0, int(gaze[eye][1] * float(height))));
+  }
+  size_t gazePixelIndex(int eye, int width, int height) const {
+    int x, y;
+    gazePixel(eye, width, height, x, y);
+    return size_t(y) * size_t(width) + size_t(x);
   }
 };
 
@@ -112,7 +120,14 @@ struct FrameResult {
   size_t reusedPixels = 0;  ///< right-eye pixels (mask vertices when foveated) that took the left eye's shading
   size_t shadedSamples[2] = {0, 0};  ///< per eye: pixels, or mask vertices when foveated
   size_t historyPixels[2] = {0, 0};  ///< TAA: per eye, pixels that blended in their history
+  float gaze[2][2] = {{0.5f, 0.5f}, {0.5f, 0.5f}};  ///< foveated: the gaze each eye was rendered with
 };
+
+// Vergence: sets foveation.gaze[1] (image fractions, clamped to the image) to where the right eye
+// sees the point at inverse depth *leftInverseDepthAtGaze (0: at infinity) on the ray through the
+// centre of the left eye's gaze pixel; to the left eye's image position if that is null (the
+// left eye not rendered) or the point is behind the right eye.
+void vergeRightGaze(const StereoRig& rig, FoveationOptions& foveation, const float* leftInverseDepthAtGaze);
 
 // Sets the rig's per-eye resolution from "WxH" (1x1 .. 8192x8192); throws pvr::Error naming
 // --eye-size otherwise.

@@ -46,6 +46,7 @@ std::vector<TrajectoryFrame> loadTrajectory(const std::string& path) {
         if (!(g >= 0.0f && g <= 1.0f)) throw Error(where + ": gaze coordinates must lie in [0, 1]");
         frame.gaze[e][k] = g;
       }
+    frame.verge = v.size() == 9;
     frames.push_back(frame);
   }
   if (frames.empty()) throw Error("trajectory '" + path + "' has no frames");

@@ -16,6 +16,7 @@ namespace pvr {
 struct TrajectoryFrame {
   Pose head;
   float gaze[2][2] = {{0.5f, 0.5f}, {0.5f, 0.5f}};
+  bool verge = true;  ///< one gaze on the line: the right eye fixates what the left eye does
 };
 
 // Throws pvr::Error naming the file and line for anything malformed (wrong count of numbers,
