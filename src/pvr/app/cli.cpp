@@ -233,9 +233,13 @@ int runRender(const RenderArgs& a) {
     if (e == 1 && options.stereo == StereoMode::Scatter) std::printf(", scatter %.2f", frame.timings.scatterMs);
     std::printf(")\n");
   }
-  if (options.stereo != StereoMode::Separate) {
+  if (options.stereo != StereoMode::Separate && options.foveation.mask) {
+    std::printf("  stereo %s: right eye took %.1f%% of its %zu vertices from the left; right/left time %.2f\n",
+                stereoModeName(options.stereo), 100.0 * double(frame.reusedPixels) / double(std::max<size_t>(frame.shadedSamples[1], 1)),
+                frame.shadedSamples[1], frame.timings.eyeMs[0] > 0 ? frame.timings.eyeMs[1] / frame.timings.eyeMs[0] : 0.0);
+  } else if (options.stereo != StereoMode::Separate) {
     double pixels = double(rig.width) * rig.height, surface = 0;
-    for (uint32_t prim : frame.eyes[1].firstPrim) surface += prim != ~0u ? 1.0 : 0.0;
+    for (float w : frame.eyes[1].inverseDepth) surface += w > 0.0f ? 1.0 : 0.0;
     std::printf("  stereo %s: right eye reused %.1f%% of its pixels (%.1f%% of those that see a surface) from the "
                 "left; right/left time %.2f\n",
                 stereoModeName(options.stereo), 100.0 * double(frame.reusedPixels) / pixels,
@@ -260,11 +264,11 @@ int runRender(const RenderArgs& a) {
       std::printf("wrote %s\n", path.c_str());
     }
   }
-  if (options.stereo != StereoMode::Separate) {  // where the right eye took the left eye's shading
+  if (!frame.eyes[1].reusedFrom.empty()) {  // where the right eye took the left eye's shading (per pixel)
     const EyeResult& right = frame.eyes[1];
     Image mask(right.image.width, right.image.height);
     for (size_t i = 0; i < mask.pixels.size(); ++i)
-      mask.pixels[i] = right.reusedFrom[i] != kNotReused ? Vec3(1.0f) : (right.firstPrim[i] != ~0u ? Vec3(0.15f, 0, 0) : Vec3(0.0f));
+      mask.pixels[i] = right.reusedFrom[i] != kNotReused ? Vec3(1.0f) : (right.inverseDepth[i] > 0.0f ? Vec3(0.15f, 0, 0) : Vec3(0.0f));
     std::string path = a.out + "_right_reused.png";
     writeImage(mask, path, 1.0f);
     std::printf("wrote %s (white: reused from the left eye; red: shaded by the right eye; black: background)\n", path.c_str());

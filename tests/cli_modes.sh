@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Every render mode through the real executable on a small eye: exit 0 and the images written.
+# Catches what unit tests cannot: the CLI's own handling of each mode's results. The third
+# argument picks the backend (default cpu; the GPU machine runs it with cuda).
+set -u
+exe=$1
+data=$2
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+small=(--eye-size 64x72 --photons 32x32 --backend "${3:-cpu}")
+failures=0
+expect_render() {  # name, files expected under $out, arguments...
+  local name=$1 files=$2
+  shift 2
+  if ! "$exe" render cornell "${small[@]}" --out "$out/$name" "$@" >"$out/stdout" 2>"$out/stderr"; then
+    echo "FAIL ($name: $*): exit code $?: $(tail -3 "$out/stderr")"
+    failures=$((failures + 1))
+    return
+  fi
+  for f in $files; do
+    if [ ! -s "$out/$f" ]; then
+      echo "FAIL ($name: $*): $f not written"
+      failures=$((failures + 1))
+      return
+    fi
+  done
+  echo "ok   ($name: $*)"
+}
+expect_render full "full_left.png full_right.exr"
+expect_render gather "gather_right.png gather_right_reused.png" --stereo gather
+expect_render scatter "scatter_right_reused.png" --stereo scatter
+expect_render fov "fov_left.png fov_right.png" --foveated --gaze 0.3,0.6
+expect_render fovgather "fovgather_right.png" --foveated --stereo gather
+expect_render fovscatter "fovscatter_right.png" --foveated --stereo scatter --gaze 0.6,0.4
+expect_render taa "taa_0004_left.png taa_0004_right.exr" --taa --trajectory "$data/gaze_pursuit.traj"
+expect_render fovtaa "fovtaa_0000_left.png fovtaa_0004_right.png" --foveated --taa --taa-blend 0.2 --stereo gather \
+  --trajectory "$data/gaze_pursuit.traj"
+grep -q "TAA history kept on" "$out/stdout" || { echo "FAIL: no TAA history share printed"; failures=$((failures + 1)); }
+[ "$failures" -eq 0 ] && echo "all render modes passed" || echo "$failures render mode(s) failed"
+exit $((failures > 0))
