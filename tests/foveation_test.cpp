@@ -154,6 +154,41 @@ TEST(FoveationMask, ReconstructsConstantAndLinearColourFieldsExactly) {
   }
 }
 
+// The GPU raster sorts triangles by triangleBoxSize at a central gaze once (a load-balancing hint:
+// each triangle still computes its own bounds). Inside the image it is triangleBounds' box, and
+// at any other gaze that box is at most a pixel wider or taller (float rounding).
+TEST(FoveationMask, TriangleBoxSizeBarelyDependsOnTheGaze) {
+  FoveationMask mask = generateFoveationMask(smallParams());
+  const int w = mask.params.width, h = mask.params.height;
+  size_t compared = 0, small = 0, same = 0;
+  for (size_t t = 0; t < mask.triangleCount(); ++t) {
+    int bw, bh;
+    triangleBoxSize(mask.offsets.data(), mask.triangles.data(), t, w / 2, h / 2, bw, bh);
+    small += bw * bh <= 8 ? 1 : 0;
+    for (auto [gx, gy] : {std::pair{w / 2, h / 2}, std::pair{w / 3, 2 * h / 3}, std::pair{w - 7, 5}}) {
+      MaskPoint v[3];
+      uint32_t index[3];
+      placeTriangle(mask.offsets.data(), mask.triangles.data(), t, gx, gy, v, index);
+      bool inside = true;
+      for (const MaskPoint& p : v) inside = inside && p.x > 2 && p.y > 2 && p.x < w - 2 && p.y < h - 2;
+      if (!inside) continue;
+      int x0, x1, y0, y1;
+      ASSERT_TRUE(triangleBounds(v, w, h, x0, x1, y0, y1));
+      if (gx == w / 2 && gy == h / 2) {
+        ASSERT_EQ(x1 - x0, bw) << "triangle " << t;
+        ASSERT_EQ(y1 - y0, bh) << "triangle " << t;
+      }
+      ASSERT_LE(std::abs(x1 - x0 - bw), 1) << "triangle " << t << " gaze " << gx << "," << gy;
+      ASSERT_LE(std::abs(y1 - y0 - bh), 1) << "triangle " << t << " gaze " << gx << "," << gy;
+      same += x1 - x0 == bw && y1 - y0 == bh ? 1 : 0;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, mask.triangleCount() / 4);
+  EXPECT_GT(same, compared / 2);
+  EXPECT_GT(small, mask.triangleCount() / 4) << "the fovea's triangles are small";
+}
+
 TEST(FoveationMask, DefaultHeadsetMaskShadesAtLeastFourTimesFewerSamples) {
   for (AcuityKind kind : {AcuityKind::LinearMar, AcuityKind::GeislerPerry}) {
     MaskParams p;  // 1440x1600

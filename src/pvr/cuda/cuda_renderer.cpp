@@ -37,16 +37,33 @@ struct CudaFrameRenderer::Impl {
   const FoveationMask* maskSource = nullptr;
   size_t maskVertices = 0;
   cuda::DeviceBuffer<MaskPoint> maskOffsets;
-  cuda::DeviceBuffer<uint32_t> maskTriangles;
+  cuda::DeviceBuffer<uint32_t> maskTriangles, maskTrianglesBySize;
+  uint32_t smallTriangles = 0;
 
   cuda::DeviceMaskView uploadMask(const FoveationMask& mask) {
     if (maskSource != &mask || maskVertices != mask.offsets.size()) {
       maskOffsets.upload(mask.offsets.data(), mask.offsets.size(), "foveation mask vertices", stream);
       maskTriangles.upload(mask.triangles.data(), mask.triangles.size(), "foveation mask triangles", stream);
+      std::vector<uint32_t> small, large;
+      for (size_t t = 0; t < mask.triangleCount(); ++t) {  // sized at a central gaze: a load-balancing hint
+        int w, h;
+        triangleBoxSize(mask.offsets.data(), mask.triangles.data(), t, mask.params.width / 2, mask.params.height / 2, w, h);
+        (w * h <= cuda::kSmallTrianglePixels ? small : large).push_back(uint32_t(t));
+      }
+      smallTriangles = uint32_t(small.size());
+      small.insert(small.end(), large.begin(), large.end());
+      maskTrianglesBySize.upload(small.data(), small.size(), "foveation mask triangles by size", stream);
+      PVR_CUDA_CHECK(cudaStreamSynchronize(stream));  // the host lists go out of scope
       maskSource = &mask;
       maskVertices = mask.offsets.size();
     }
-    return {maskOffsets.data(), maskTriangles.data(), uint32_t(mask.offsets.size()), uint32_t(mask.triangleCount())};
+    cuda::DeviceMaskView view{maskOffsets.data(), maskTriangles.data(), uint32_t(mask.offsets.size()),
+                              uint32_t(mask.triangleCount())};
+    view.smallTriangles = maskTrianglesBySize.data();
+    view.largeTriangles = maskTrianglesBySize.data() + smallTriangles;
+    view.smallCount = smallTriangles;
+    view.largeCount = uint32_t(mask.triangleCount()) - smallTriangles;
+    return view;
   }
   cuda::EyeTimers eyeTimers[2];
   cudaDeviceProp properties{};

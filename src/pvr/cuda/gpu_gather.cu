@@ -293,13 +293,16 @@ __global__ void listedDensityKernel(Map map, DensityParams density, const Gather
   colours[vertex] = finishGather(map, points[vertex], density);
 }
 
-// One warp per triangle, its lanes splitting the triangle's bounding box: the periphery's
-// triangles cover hundreds of pixels, the fovea's one, so a thread per triangle would leave the
-// GPU waiting on the few largest.
-__global__ void rasterKernel(DeviceMaskView mask, int gazeX, int gazeY, VertexValues vertices, RasterTarget target) {
-  uint32_t t = (blockIdx.x * blockDim.x + threadIdx.x) >> 5;
-  if (t < mask.triangleCount)
-    rasterizeTriangle(mask.offsets, mask.triangles, t, gazeX, gazeY, vertices, target, int(threadIdx.x & 31u), 32);
+// `Lanes` threads per listed triangle, splitting its bounding box: the periphery's triangles
+// cover hundreds of pixels (a warp each, or the GPU waits on the largest), the fovea's one or two
+// (a thread each, or 30 of 32 lanes idle).
+template <int Lanes>
+__global__ void rasterKernel(DeviceMaskView mask, const uint32_t* list, uint32_t count, int gazeX, int gazeY,
+                             VertexValues vertices, RasterTarget target) {
+  uint32_t i = (blockIdx.x * blockDim.x + threadIdx.x) / Lanes;
+  if (i < count)
+    rasterizeTriangle(mask.offsets, mask.triangles, list[i], gazeX, gazeY, vertices, target,
+                      int(threadIdx.x % Lanes), Lanes);
 }
 
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
@@ -614,7 +617,12 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
   const VertexValues values{vertexColours_.data(), vertexInverseDepths_.data()};
   const RasterTarget target{images_[int(eye)].data(), inverseDepth_[int(eye)].data(), sampleSpacing_[int(eye)].data(),
                             camera.width, camera.height};
-  rasterKernel<<<blocksFor(size_t(mask.triangleCount) * 32, 256), 256, 0, stream>>>(mask, gazeX, gazeY, values, target);
+  if (mask.smallCount)
+    rasterKernel<1><<<blocksFor(mask.smallCount, 256), 256, 0, stream>>>(mask, mask.smallTriangles, mask.smallCount,
+                                                                         gazeX, gazeY, values, target);
+  if (mask.largeCount)
+    rasterKernel<32><<<blocksFor(size_t(mask.largeCount) * 32, 256), 256, 0, stream>>>(
+        mask, mask.largeTriangles, mask.largeCount, gazeX, gazeY, values, target);
   PVR_CUDA_CHECK_LAUNCH("raster");
   reconstruct.stop(stream);
 }

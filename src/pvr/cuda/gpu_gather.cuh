@@ -50,12 +50,17 @@ struct EyeOutputs {
   unsigned* reusedCount = nullptr;    ///< with reusedFrom: pixels that took the left eye's shading
 };
 
-// A foveation mask on the device.
+// A foveation mask on the device, its triangles also listed by size for the raster: a thread
+// each for the small ones (the fovea's, a pixel or two), a warp each for the rest.
 struct DeviceMaskView {
   const MaskPoint* offsets = nullptr;
   const uint32_t* triangles = nullptr;  ///< 3 per triangle
   uint32_t vertexCount = 0, triangleCount = 0;
+  const uint32_t* smallTriangles = nullptr;  ///< at most kSmallTrianglePixels candidate pixels
+  const uint32_t* largeTriangles = nullptr;
+  uint32_t smallCount = 0, largeCount = 0;
 };
+constexpr int kSmallTrianglePixels = 8;
 
 class GpuGather {
  public:

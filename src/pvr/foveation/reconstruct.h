@@ -78,6 +78,20 @@ PVR_HOST_DEVICE inline bool triangleBounds(const MaskPoint v[3], int width, int 
   return x0 < x1 && y0 < y1;
 }
 
+// The size of triangleBounds' box for a mask triangle placed at gaze pixel (gazeX, gazeY), not
+// clipped to any image. The mask moves by whole pixels, so elsewhere the box is the same but for
+// float rounding: at most a pixel wider or taller.
+inline void triangleBoxSize(const MaskPoint* offsets, const uint32_t* triangles, size_t t, int gazeX, int gazeY,
+                            int& boxWidth, int& boxHeight) {
+  MaskPoint v[3];
+  uint32_t index[3];
+  placeTriangle(offsets, triangles, t, gazeX, gazeY, v, index);
+  float minX = fminf(fminf(v[0].x, v[1].x), v[2].x), maxX = fmaxf(fmaxf(v[0].x, v[1].x), v[2].x);
+  float minY = fminf(fminf(v[0].y, v[1].y), v[2].y), maxY = fmaxf(fmaxf(v[0].y, v[1].y), v[2].y);
+  boxWidth = int(ceilf(maxX - 0.5f) + 1.0f - floorf(minX - 0.5f));
+  boxHeight = int(ceilf(maxY - 0.5f) + 1.0f - floorf(minY - 0.5f));
+}
+
 // A mask's per-vertex values, and what the raster writes per pixel (null pointers: nothing).
 struct VertexValues {
   const Vec3* colours = nullptr;
