@@ -476,7 +476,7 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
     for (double p : psnr) std::printf(c == 0 ? " ref |" : " %.1f |", p);
     std::printf(" %s |\n", ok ? "ok" : "MISMATCH");
     const double rightLeft = cell.eyeMs[1] / std::max(cell.eyeMs[0], 1e-9);
-    const double reusedShare = double(cell.reusedPixels) / std::max(samples, 1.0);
+    const double reusedShare = double(cell.reusedPixels) / std::max(double(cell.last.shadedSamples[1]), 1.0);
     if (columns[c].stereo != StereoMode::Separate)
       reuseNotes += "- " + columns[c].name + ": the right eye took " + std::to_string(int(100.0 * reusedShare + 0.5)) +
                     "% of its vertices from the left; right/left eye time " + std::to_string(rightLeft).substr(0, 4) + "\n";

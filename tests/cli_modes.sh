@@ -9,11 +9,17 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 small=(--eye-size 64x72 --photons 32x32 --backend "${3:-cpu}")
 failures=0
+if [ "${3:-cpu}" = cuda ] && ! "$exe" render --backend cuda --eye-size 8x8 --photons 8x8 --out "$out/probe" >/dev/null 2>&1; then
+  echo "no usable CUDA GPU: skipped"
+  exit 77
+fi
 expect_render() {  # name, files expected under $out, arguments...
   local name=$1 files=$2
   shift 2
-  if ! "$exe" render cornell "${small[@]}" --out "$out/$name" "$@" >"$out/stdout" 2>"$out/stderr"; then
-    echo "FAIL ($name: $*): exit code $?: $(tail -3 "$out/stderr")"
+  "$exe" render cornell "${small[@]}" --out "$out/$name" "$@" >"$out/stdout" 2>"$out/stderr"
+  local rc=$?
+  if [ "$rc" -ne 0 ]; then
+    echo "FAIL ($name: $*): exit code $rc: $(tail -3 "$out/stderr")"
     failures=$((failures + 1))
     return
   fi

@@ -215,6 +215,11 @@ TEST(FoveationMask, FileRoundTripAndBadFiles) {
   EXPECT_EQ(back.triangles, mask.triangles);
   ASSERT_EQ(back.offsets.size(), mask.offsets.size());
   for (size_t i = 0; i < mask.offsets.size(); ++i) ASSERT_EQ(back.offsets[i].x, mask.offsets[i].x);
+  // Every mask made or loaded has its own id (what the GPU keys its uploaded copy on); copies share it.
+  EXPECT_NE(back.id, 0u);
+  EXPECT_NE(back.id, mask.id);
+  FoveationMask copy = back;
+  EXPECT_EQ(copy.id, back.id);
 
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -239,6 +239,14 @@ TEST(Temporal, ResetAndNewEyeSizeStartFromTheRenderedFrame) {
   EXPECT_GT(renderer.render(rig, o).historyPixels[1], 0u);
   StereoRig bigger = smallRig(scene, 96, 88);
   EXPECT_EQ(renderer.render(bigger, o).historyPixels[0], 0u);
+  // An eye left out for a frame comes back without its (stale) history.
+  EXPECT_GT(renderer.render(bigger, o).historyPixels[1], 0u);
+  o.eyes[1] = false;
+  renderer.render(bigger, o);
+  o.eyes[1] = true;
+  FrameResult back = renderer.render(bigger, o);
+  EXPECT_EQ(back.historyPixels[1], 0u);
+  EXPECT_GT(back.historyPixels[0], 0u);
   // Out-of-range parameters are refused.
   o.temporal.taa.blend = 0.0f;
   EXPECT_THROW(renderer.render(rig, o), Error);

@@ -129,8 +129,7 @@ FrameResult renderFrame(const CpuBackend& backend, const StereoRig& rig, const R
 FrameResult CpuFrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
   FrameResult frame = renderFrame(backend_, rig, options);
   for (int e = 0; e < 2; ++e) {
-    if (!options.eyes[e]) continue;
-    if (!options.temporal.enabled) {
+    if (!options.eyes[e] || !options.temporal.enabled) {  // a skipped eye's history would be stale
       history_[e].valid = false;
       continue;
     }

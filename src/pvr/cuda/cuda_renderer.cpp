@@ -33,36 +33,37 @@ struct CudaFrameRenderer::Impl {
   cuda::GpuGather gather;
   cuda::GpuTemporal temporal;
   cuda::EventTimer traceTimer, buildTimer, scatterTimer, reconstructTimer[2], temporalTimer[2];
-  // The foveation mask last used (uploaded once; the frame's mask is compared by content size and address).
-  const FoveationMask* maskSource = nullptr;
-  size_t maskVertices = 0;
+  // The foveation mask last used, uploaded once and keyed on its content id.
+  uint64_t maskId = 0;
+  uint32_t maskVertices = 0, maskTriangleCount = 0;
   cuda::DeviceBuffer<MaskPoint> maskOffsets;
   cuda::DeviceBuffer<uint32_t> maskTriangles, maskTrianglesBySize;
   uint32_t smallTriangles = 0;
 
   cuda::DeviceMaskView uploadMask(const FoveationMask& mask) {
-    if (maskSource != &mask || maskVertices != mask.offsets.size()) {
+    if (mask.id == 0 || mask.id != maskId) {
       maskOffsets.upload(mask.offsets.data(), mask.offsets.size(), "foveation mask vertices", stream);
       maskTriangles.upload(mask.triangles.data(), mask.triangles.size(), "foveation mask triangles", stream);
       std::vector<uint32_t> small, large;
       for (size_t t = 0; t < mask.triangleCount(); ++t) {  // sized at a central gaze: a load-balancing hint
         int w, h;
         triangleBoxSize(mask.offsets.data(), mask.triangles.data(), t, mask.params.width / 2, mask.params.height / 2, w, h);
-        (w * h <= cuda::kSmallTrianglePixels ? small : large).push_back(uint32_t(t));
+        (int64_t(w) * h <= cuda::kSmallTrianglePixels ? small : large).push_back(uint32_t(t));
       }
       smallTriangles = uint32_t(small.size());
       small.insert(small.end(), large.begin(), large.end());
       maskTrianglesBySize.upload(small.data(), small.size(), "foveation mask triangles by size", stream);
       PVR_CUDA_CHECK(cudaStreamSynchronize(stream));  // the host lists go out of scope
-      maskSource = &mask;
-      maskVertices = mask.offsets.size();
+      maskId = mask.id;
+      maskVertices = uint32_t(mask.offsets.size());
+      maskTriangleCount = uint32_t(mask.triangleCount());
     }
-    cuda::DeviceMaskView view{maskOffsets.data(), maskTriangles.data(), uint32_t(mask.offsets.size()),
-                              uint32_t(mask.triangleCount())};
+    // Everything from the uploaded copy, nothing from the live mask.
+    cuda::DeviceMaskView view{maskOffsets.data(), maskTriangles.data(), maskVertices, maskTriangleCount};
     view.smallTriangles = maskTrianglesBySize.data();
     view.largeTriangles = maskTrianglesBySize.data() + smallTriangles;
     view.smallCount = smallTriangles;
-    view.largeCount = uint32_t(mask.triangleCount()) - smallTriangles;
+    view.largeCount = maskTriangleCount - smallTriangles;
     return view;
   }
   cuda::EyeTimers eyeTimers[2];
@@ -132,7 +133,10 @@ FrameResult CudaFrameRenderer::render(const StereoRig& rig, const RenderOptions&
   unsigned reused = 0;
   RenderOptions eyeOptions = options;  // foveated: the right eye's gaze may follow the left's
   for (int e = 0; e < 2; ++e) {  // the left eye first: the right eye may reuse it
-    if (!options.eyes[e]) continue;
+    if (!options.eyes[e]) {
+      m.temporal.forget(Eye(e));  // its history would be stale when it comes back
+      continue;
+    }
     if (e == 1 && options.stereo == StereoMode::Scatter) {
       m.scatterTimer.start(m.stream);
       m.gather.scatter(m.deviceScene, rig, m.stream);

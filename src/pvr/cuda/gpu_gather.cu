@@ -1,5 +1,7 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_select.cuh>
+#include <thrust/execution_policy.h>
+#include <thrust/fill.h>
 #include <thrust/iterator/counting_iterator.h>
 
 #include <algorithm>
@@ -614,6 +616,7 @@ void GpuGather::renderFoveatedEye(const DeviceScene& scene, DeviceMap map, const
   // A gaze inside the image leaves no pixel uncovered; these are for the rest.
   PVR_CUDA_CHECK(cudaMemsetAsync(images_[int(eye)].data(), 0, pixels * sizeof(Vec3), stream));
   PVR_CUDA_CHECK(cudaMemsetAsync(inverseDepth_[int(eye)].data(), 0, pixels * sizeof(float), stream));
+  thrust::fill_n(thrust::cuda::par.on(stream), sampleSpacing_[int(eye)].data(), pixels, 1.0f);  // as on the CPU
   const VertexValues values{vertexColours_.data(), vertexInverseDepths_.data()};
   const RasterTarget target{images_[int(eye)].data(), inverseDepth_[int(eye)].data(), sampleSpacing_[int(eye)].data(),
                             camera.width, camera.height};

@@ -1,5 +1,7 @@
 #include "pvr/foveation/mask.h"
 
+#include <atomic>
+
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
@@ -73,6 +75,11 @@ double sampleSpacingPixels(const MaskParams& p, double radiusPixels) {
   return std::max(1.0, acuity / pixelPitchDeg(radiusPixels, p.tanPerPixel));
 }
 
+uint64_t newMaskId() {
+  static std::atomic<uint64_t> next{1};
+  return next++;
+}
+
 FoveationMask generateFoveationMask(const MaskParams& params) {
   checkParams(params);
   FoveationMask mask;
@@ -113,6 +120,7 @@ FoveationMask generateFoveationMask(const MaskParams& params) {
   mask.triangles.reserve(delaunay.number_of_faces() * 3);
   for (auto face = delaunay.finite_faces_begin(); face != delaunay.finite_faces_end(); ++face)
     for (int k = 0; k < 3; ++k) mask.triangles.push_back(face->vertex(k)->info());
+  mask.id = newMaskId();
   return mask;
 }
 
@@ -179,6 +187,7 @@ FoveationMask loadFoveationMask(const std::string& path) {
     if (!std::isfinite(v.x) || !std::isfinite(v.y)) throw Error("mask file '" + path + "' is corrupt: non-finite vertex");
   for (uint32_t i : mask.triangles)
     if (i >= vertices) throw Error("mask file '" + path + "' is corrupt: vertex index out of range");
+  mask.id = newMaskId();
   return mask;
 }
 

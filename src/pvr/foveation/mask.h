@@ -30,9 +30,16 @@ struct FoveationMask {
   std::vector<MaskPoint> offsets;   ///< pixels, relative to the gaze pixel's centre
   std::vector<uint32_t> triangles;  ///< 3 vertex indices per triangle (Delaunay)
   int fullDensityRadius = 0;        ///< pixels: every pixel centre within it is a vertex
+  /// Identifies the content: each mask made or loaded gets a new one (copies keep it). Backends
+  /// that upload a mask once key their copy on it; change the content, give it a new one
+  /// (newMaskId()).
+  uint64_t id = 0;
 
   size_t triangleCount() const { return triangles.size() / 3; }
 };
+
+// A process-wide unique mask id.
+uint64_t newMaskId();
 
 // Eccentricity (degrees) of a point `radiusPixels` from the gaze, and the angular size (degrees)
 // of a pixel there, along the radius, for an image plane with `tanPerPixel`.

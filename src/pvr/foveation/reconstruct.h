@@ -88,8 +88,9 @@ inline void triangleBoxSize(const MaskPoint* offsets, const uint32_t* triangles,
   placeTriangle(offsets, triangles, t, gazeX, gazeY, v, index);
   float minX = fminf(fminf(v[0].x, v[1].x), v[2].x), maxX = fmaxf(fmaxf(v[0].x, v[1].x), v[2].x);
   float minY = fminf(fminf(v[0].y, v[1].y), v[2].y), maxY = fmaxf(fmaxf(v[0].y, v[1].y), v[2].y);
-  boxWidth = int(ceilf(maxX - 0.5f) + 1.0f - floorf(minX - 0.5f));
-  boxHeight = int(ceilf(maxY - 0.5f) + 1.0f - floorf(minY - 0.5f));
+  const float limit = 1 << 24;  // a loaded mask may hold any finite offsets
+  boxWidth = int(fminf(ceilf(maxX - 0.5f) + 1.0f - floorf(minX - 0.5f), limit));
+  boxHeight = int(fminf(ceilf(maxY - 0.5f) + 1.0f - floorf(minY - 0.5f), limit));
 }
 
 // A mask's per-vertex values, and what the raster writes per pixel (null pointers: nothing).
