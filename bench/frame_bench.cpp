@@ -318,6 +318,17 @@ int runStereo(const FrameBenchArgs& args, FrameRenderer& renderer, nlohmann::jso
   return failures;
 }
 
+// The foveation suite's frames (its headings state them): 512x512 photons, r = 0.05, the paper's
+// photon-map-only shading; `mask` null for full resolution.
+RenderOptions foveationBenchOptions(const FoveationMask* mask) {
+  RenderOptions o;
+  o.photonsX = o.photonsY = 512;
+  o.gather.mode = ShadingMode::PhotonMapOnly;
+  o.gather.density.radius = 0.05f;
+  o.foveation.mask = mask;
+  return o;
+}
+
 // Temporal flicker of foveated rendering with a static head and a moving gaze (smooth pursuit
 // around a circle of 0.1 image widths, ~10 deg, in 2 s at 90 Hz: about 31 deg/s), without and
 // with TAA: the mean absolute difference of consecutive displayed (sRGB) left-eye frames. The
@@ -349,11 +360,7 @@ int runFlicker(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& re
   int failures = 0;
   double noTaaFlicker = 0;
   for (size_t r = 0; r < rows.size(); ++r) {
-    RenderOptions o;
-    o.photonsX = o.photonsY = 512;
-    o.gather.mode = ShadingMode::PhotonMapOnly;
-    o.gather.density.radius = 0.05f;
-    o.foveation.mask = &mask;
+    RenderOptions o = foveationBenchOptions(&mask);
     o.temporal.enabled = rows[r].taa;
     o.temporal.taa.blend = rows[r].blend;
     renderer.resetHistory();
@@ -439,11 +446,7 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
   FrameResult reference;
   std::string reuseNotes;
   for (size_t c = 0; c < columns.size(); ++c) {
-    RenderOptions o;
-    o.photonsX = o.photonsY = 512;
-    o.gather.mode = ShadingMode::PhotonMapOnly;
-    o.gather.density.radius = 0.05f;
-    o.foveation.mask = columns[c].mask;
+    RenderOptions o = foveationBenchOptions(columns[c].mask);
     o.stereo = columns[c].stereo;
     o.foveation.gaze[0][0] = columns[c].gazeX, o.foveation.gaze[0][1] = columns[c].gazeY;
     o.foveation.verge = true;  // both eyes fixate one point

@@ -13,18 +13,44 @@
 namespace pvr {
 namespace {
 
-// Mean absolute difference of two images relative to the first's mean (all channels).
-double relativeDifference(const Image& a, const Image& b) {
+double absoluteSum(float v) { return std::fabs(v); }
+double absoluteSum(Vec3 v) { return double(std::fabs(v.x)) + std::fabs(v.y) + std::fabs(v.z); }
+
+// Sum of absolute values (all channels) of reference images, and of their differences from others.
+struct Difference {
   double sum = 0, diff = 0;
-  for (size_t i = 0; i < a.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) sum += std::fabs(a.pixels[i][c]), diff += std::fabs(a.pixels[i][c] - b.pixels[i][c]);
-  return diff / std::max(sum, 1e-30);
+  template <class T>
+  void add(const std::vector<T>& reference, const std::vector<T>& other) {
+    for (size_t i = 0; i < reference.size(); ++i) sum += absoluteSum(reference[i]), diff += absoluteSum(reference[i] - other[i]);
+  }
+  double relative() const { return diff / std::max(sum, 1e-30); }  ///< mean absolute difference over the mean
+};
+
+template <class T>
+double relativeDifference(const std::vector<T>& reference, const std::vector<T>& other) {
+  Difference d;
+  d.add(reference, other);
+  return d.relative();
 }
 
-double relativeDifference(const std::vector<float>& a, const std::vector<float>& b) {
-  double sum = 0, diff = 0;
-  for (size_t i = 0; i < a.size(); ++i) sum += std::fabs(a[i]), diff += std::fabs(a[i] - b[i]);
-  return diff / std::max(sum, 1e-30);
+// A scene on both backends, its rig resized (0: the scene's own size).
+struct BothBackends {
+  Scene scene;
+  StereoRig rig;
+  CpuFrameRenderer cpu;
+  CudaFrameRenderer gpu;
+  BothBackends(const char* name, int width = 0, int height = 0)
+      : scene(builtinScene(name)), rig(scene.rig), cpu(scene), gpu(scene) {
+    if (width) rig.width = width, rig.height = height;
+  }
+};
+
+// The photons and radius every image comparison uses.
+RenderOptions comparisonOptions() {
+  RenderOptions o;
+  o.photonsX = o.photonsY = 128;
+  o.gather.density.radius = 0.08f;
+  return o;
 }
 
 #define PVR_REQUIRE_GPU()                                          \
@@ -84,24 +110,21 @@ struct ImageCheck {
 
 ImageCheck compare(const FrameResult& a, const FrameResult& b) {
   ImageCheck c;
-  double sum = 0, diff = 0;
+  Difference d;
   size_t n = 0, outliers = 0, same = 0;
   for (int e = 0; e < 2; ++e) {
-    const auto& pa = a.eyes[e].image.pixels;
-    const auto& pb = b.eyes[e].image.pixels;
-    for (size_t i = 0; i < pa.size(); ++i)
-      for (int k = 0; k < 3; ++k) sum += std::fabs(pa[i][k]), diff += std::fabs(pa[i][k] - pb[i][k]);
-    n += pa.size();
-    for (size_t i = 0; i < pa.size(); ++i) same += a.eyes[e].firstPrim[i] == b.eyes[e].firstPrim[i] ? 1 : 0;
+    d.add(a.eyes[e].image.pixels, b.eyes[e].image.pixels);
+    n += a.eyes[e].image.pixels.size();
+    for (size_t i = 0; i < a.eyes[e].firstPrim.size(); ++i) same += a.eyes[e].firstPrim[i] == b.eyes[e].firstPrim[i] ? 1 : 0;
   }
-  double mean = sum / (3.0 * n);
+  double mean = d.sum / (3.0 * n);
   for (int e = 0; e < 2; ++e) {
     const auto& pa = a.eyes[e].image.pixels;
     const auto& pb = b.eyes[e].image.pixels;
     for (size_t i = 0; i < pa.size(); ++i)
       if (length(pa[i] - pb[i]) > 0.1 * mean) ++outliers;
   }
-  c.relativeMad = diff / (3.0 * n) / mean;
+  c.relativeMad = d.relative();
   c.outliers = double(outliers) / double(n);
   c.firstPrimAgree = double(same) / double(n);
   return c;
@@ -112,28 +135,22 @@ ImageCheck compare(const FrameResult& a, const FrameResult& b) {
 TEST(GpuBackend, ImagesMatchTheCpuForEveryScheme) {
   PVR_REQUIRE_GPU();
   for (const char* name : {"cornell", "cornell-caustics"}) {
-    Scene scene = builtinScene(name);
-    StereoRig rig = scene.rig;
-    rig.width = 160, rig.height = 176;
-    CpuFrameRenderer cpu(scene);
-    CudaFrameRenderer gpu(scene);
+    BothBackends both(name, 160, 176);
     for (ShadingMode mode : {ShadingMode::Full, ShadingMode::PhotonMapOnly})
       for (Estimator estimator : {Estimator::Radius, Estimator::Knn})
         for (PhotonMapKind map : {PhotonMapKind::HashGrid, PhotonMapKind::KdTree}) {
-          RenderOptions o;
-          o.photonsX = o.photonsY = 128;
+          RenderOptions o = comparisonOptions();
           o.map = map;
           o.gather.mode = mode;
-          o.gather.density.radius = 0.08f;
           o.gather.density.estimator = estimator;
           o.gather.samplesPerPixel = 2;
-          FrameResult reference = cpu.render(rig, o);
+          FrameResult reference = both.cpu.render(both.rig, o);
           for (DensityKernel kernel : {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory,
                                        DensityKernel::CellSorted}) {
             if (map == PhotonMapKind::KdTree && (kernel == DensityKernel::SharedMemory || kernel == DensityKernel::CellSorted))
               continue;
             o.kernel = kernel;
-            FrameResult frame = gpu.render(rig, o);
+            FrameResult frame = both.gpu.render(both.rig, o);
             ImageCheck c = compare(reference, frame);
             std::string what = std::string(name) + " " + densityKernelName(kernel) +
                                (estimator == Estimator::Knn ? " knn" : " radius") +
@@ -154,23 +171,17 @@ TEST(GpuBackend, ImagesMatchTheCpuForEveryScheme) {
 TEST(GpuBackend, StereoReuseMatchesTheCpu) {
   PVR_REQUIRE_GPU();
   for (const char* name : {"cornell", "cornell-caustics"}) {
-    Scene scene = builtinScene(name);
-    StereoRig rig = scene.rig;
-    rig.width = 160, rig.height = 176;
-    CpuFrameRenderer cpu(scene);
-    CudaFrameRenderer gpu(scene);
+    BothBackends both(name, 160, 176);
     for (StereoMode stereo : {StereoMode::Scatter, StereoMode::Gather})
       for (int spp : {1, 2}) {
-        RenderOptions o;
-        o.photonsX = o.photonsY = 128;
-        o.gather.density.radius = 0.08f;
+        RenderOptions o = comparisonOptions();
         o.gather.samplesPerPixel = spp;
         o.stereo = stereo;
-        FrameResult reference = cpu.render(rig, o);
+        FrameResult reference = both.cpu.render(both.rig, o);
         for (DensityKernel kernel : {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory,
                                      DensityKernel::CellSorted}) {
           o.kernel = kernel;
-          FrameResult frame = gpu.render(rig, o);
+          FrameResult frame = both.gpu.render(both.rig, o);
           std::string what = std::string(name) + " " + stereoModeName(stereo) + " " + densityKernelName(kernel) +
                              " spp " + std::to_string(spp);
           ImageCheck c = compare(reference, frame);
@@ -197,16 +208,11 @@ TEST(GpuBackend, StereoReuseMatchesTheCpu) {
 // shading the same number of mask vertices, for both estimators and a gaze off the centre.
 TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
   PVR_REQUIRE_GPU();
-  Scene scene = builtinScene("cornell-caustics");
-  StereoRig rig = scene.rig;
-  rig.width = 320, rig.height = 352;
+  BothBackends both("cornell-caustics", 320, 352);
+  auto& [scene, rig, cpu, gpu] = both;
   FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
-  CpuFrameRenderer cpu(scene);
-  CudaFrameRenderer gpu(scene);
   for (Estimator estimator : {Estimator::Radius, Estimator::Knn}) {
-    RenderOptions o;
-    o.photonsX = o.photonsY = 128;
-    o.gather.density.radius = 0.08f;
+    RenderOptions o = comparisonOptions();
     o.gather.density.estimator = estimator;
     o.foveation.mask = &mask;
     o.foveation.gaze[0][0] = 0.35f, o.foveation.gaze[0][1] = 0.6f;
@@ -215,7 +221,7 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
     for (int e = 0; e < 2; ++e) {
       const char* what = estimator == Estimator::Knn ? " knn" : " radius";
       EXPECT_EQ(a.shadedSamples[e], b.shadedSamples[e]);
-      EXPECT_LT(relativeDifference(a.eyes[e].image, b.eyes[e].image), 0.01) << "eye " << e << what;
+      EXPECT_LT(relativeDifference(a.eyes[e].image.pixels, b.eyes[e].image.pixels), 0.01) << "eye " << e << what;
       EXPECT_LT(relativeDifference(a.eyes[e].inverseDepth, b.eyes[e].inverseDepth), 1e-3) << "eye " << e << what;
       EXPECT_LT(relativeDifference(a.eyes[e].sampleSpacing, b.eyes[e].sampleSpacing), 1e-6) << "eye " << e << what;
       EXPECT_TRUE(a.eyes[e].firstPrim.empty() && b.eyes[e].firstPrim.empty()) << "foveated frames have no first-hit ids";
@@ -224,9 +230,7 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
   // Stereo reuse per vertex, with the eyes verged on one point: the right eye's gaze and the
   // vertices it takes from the left agree with the CPU's.
   for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
-    RenderOptions o;
-    o.photonsX = o.photonsY = 128;
-    o.gather.density.radius = 0.08f;
+    RenderOptions o = comparisonOptions();
     o.foveation.mask = &mask;
     o.foveation.gaze[0][0] = 0.4f, o.foveation.gaze[0][1] = 0.55f;
     o.foveation.verge = true;
@@ -237,45 +241,37 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
     EXPECT_GT(a.reusedPixels, a.shadedSamples[1] / 5) << stereoModeName(mode);  // the full-density share at 320x352
     EXPECT_NEAR(double(a.reusedPixels), double(b.reusedPixels), 0.005 * double(a.shadedSamples[1])) << stereoModeName(mode);
     for (int e = 0; e < 2; ++e)
-      EXPECT_LT(relativeDifference(a.eyes[e].image, b.eyes[e].image), 0.01) << stereoModeName(mode) << " eye " << e;
+      EXPECT_LT(relativeDifference(a.eyes[e].image.pixels, b.eyes[e].image.pixels), 0.01) << stereoModeName(mode) << " eye " << e;
   }
 }
 
 // A mask with many vertices (Geisler-Perry at the headset's size): still the CPU's image.
 TEST(GpuBackend, DenseFoveationMaskMatchesTheCpu) {
   PVR_REQUIRE_GPU();
-  Scene scene = builtinScene("cornell");
-  StereoRig rig = scene.rig;
+  BothBackends both("cornell");
+  auto& [scene, rig, cpu, gpu] = both;
   MaskParams params = maskParamsForRig(rig);
   params.acuity.kind = AcuityKind::GeislerPerry;
   FoveationMask mask = generateFoveationMask(params);
   ASSERT_GT(mask.offsets.size(), 200000u);
-  CpuFrameRenderer cpu(scene);
-  CudaFrameRenderer gpu(scene);
-  RenderOptions o;
-  o.photonsX = o.photonsY = 128;
+  RenderOptions o = comparisonOptions();
   o.gather.density.radius = 0.05f;
   o.eyes[1] = false;
   o.foveation.mask = &mask;
   FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
   EXPECT_EQ(a.shadedSamples[0], b.shadedSamples[0]);
-  EXPECT_LT(relativeDifference(a.eyes[0].image, b.eyes[0].image), 0.01);
+  EXPECT_LT(relativeDifference(a.eyes[0].image.pixels, b.eyes[0].image.pixels), 0.01);
 }
 
 // TAA over a few frames of head motion and a moving gaze, full resolution and foveated: the
 // displayed images, and how many pixels kept their history, agree with the CPU's.
 TEST(GpuBackend, TemporalAntiAliasingMatchesTheCpu) {
   PVR_REQUIRE_GPU();
-  Scene scene = builtinScene("cornell-caustics");
-  StereoRig rig = scene.rig;
-  rig.width = 320, rig.height = 352;
+  BothBackends both("cornell-caustics", 320, 352);
+  auto& [scene, rig, cpu, gpu] = both;
   FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
-  CpuFrameRenderer cpu(scene);
-  CudaFrameRenderer gpu(scene);
   for (bool foveated : {false, true}) {
-    RenderOptions o;
-    o.photonsX = o.photonsY = 128;
-    o.gather.density.radius = 0.08f;
+    RenderOptions o = comparisonOptions();
     o.temporal.enabled = true;
     o.foveation.mask = foveated ? &mask : nullptr;
     cpu.resetHistory();
@@ -287,7 +283,7 @@ TEST(GpuBackend, TemporalAntiAliasingMatchesTheCpu) {
       FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
       for (int e = 0; e < 2; ++e) {
         const std::string what = std::string(foveated ? "foveated" : "full") + ", frame " + std::to_string(f) + ", eye " + std::to_string(e);
-        EXPECT_LT(relativeDifference(a.eyes[e].image, b.eyes[e].image), 0.01) << what;
+        EXPECT_LT(relativeDifference(a.eyes[e].image.pixels, b.eyes[e].image.pixels), 0.01) << what;
         EXPECT_LT(relativeDifference(a.eyes[e].inverseDepth, b.eyes[e].inverseDepth), 1e-3) << what;
         const double pixels = double(rig.width) * rig.height;
         EXPECT_NEAR(double(a.historyPixels[e]) / pixels, double(b.historyPixels[e]) / pixels, 0.005) << what;

@@ -63,18 +63,25 @@ PVR_HOST_DEVICE inline void placeTriangle(const MaskPoint* offsets, const uint32
   }
 }
 
-// Pixels [x0, x1) x [y0, y1) whose centres the triangle may cover, clipped to the image; false
-// if none.
+// Pixels [x0, x1) x [y0, y1) whose centres the triangle may cover, not clipped to any image (in
+// floats: a loaded mask may hold offsets no int holds).
+PVR_HOST_DEVICE inline void pixelBox(const MaskPoint v[3], float& x0, float& x1, float& y0, float& y1) {
+  x0 = floorf(fminf(fminf(v[0].x, v[1].x), v[2].x) - 0.5f);
+  y0 = floorf(fminf(fminf(v[0].y, v[1].y), v[2].y) - 0.5f);
+  x1 = ceilf(fmaxf(fmaxf(v[0].x, v[1].x), v[2].x) - 0.5f) + 1.0f;
+  y1 = ceilf(fmaxf(fmaxf(v[0].y, v[1].y), v[2].y) - 0.5f) + 1.0f;
+}
+
+// The pixel box clipped to the image; false if empty.
 PVR_HOST_DEVICE inline bool triangleBounds(const MaskPoint v[3], int width, int height, int& x0, int& x1, int& y0,
                                            int& y1) {
-  float minX = fminf(fminf(v[0].x, v[1].x), v[2].x), maxX = fmaxf(fmaxf(v[0].x, v[1].x), v[2].x);
-  float minY = fminf(fminf(v[0].y, v[1].y), v[2].y), maxY = fmaxf(fmaxf(v[0].y, v[1].y), v[2].y);
-  // Far outside: no pixel (and no int overflow below).
-  if (maxX < -1.0f || maxY < -1.0f || minX > float(width) + 1.0f || minY > float(height) + 1.0f) return false;
-  x0 = int(fmaxf(0.0f, floorf(minX - 0.5f)));
-  y0 = int(fmaxf(0.0f, floorf(minY - 0.5f)));
-  x1 = int(fminf(float(width), ceilf(maxX - 0.5f) + 1.0f));
-  y1 = int(fminf(float(height), ceilf(maxY - 0.5f) + 1.0f));
+  float fx0, fx1, fy0, fy1;
+  pixelBox(v, fx0, fx1, fy0, fy1);
+  if (!(fx1 > 0.0f && fy1 > 0.0f && fx0 < float(width) && fy0 < float(height))) return false;  // before int conversion
+  x0 = int(fmaxf(0.0f, fx0));
+  y0 = int(fmaxf(0.0f, fy0));
+  x1 = int(fminf(float(width), fx1));
+  y1 = int(fminf(float(height), fy1));
   return x0 < x1 && y0 < y1;
 }
 
@@ -86,11 +93,11 @@ inline void triangleBoxSize(const MaskPoint* offsets, const uint32_t* triangles,
   MaskPoint v[3];
   uint32_t index[3];
   placeTriangle(offsets, triangles, t, gazeX, gazeY, v, index);
-  float minX = fminf(fminf(v[0].x, v[1].x), v[2].x), maxX = fmaxf(fmaxf(v[0].x, v[1].x), v[2].x);
-  float minY = fminf(fminf(v[0].y, v[1].y), v[2].y), maxY = fmaxf(fmaxf(v[0].y, v[1].y), v[2].y);
+  float x0, x1, y0, y1;
+  pixelBox(v, x0, x1, y0, y1);
   const float limit = 1 << 24;  // a loaded mask may hold any finite offsets
-  boxWidth = int(fminf(ceilf(maxX - 0.5f) + 1.0f - floorf(minX - 0.5f), limit));
-  boxHeight = int(fminf(ceilf(maxY - 0.5f) + 1.0f - floorf(minY - 0.5f), limit));
+  boxWidth = int(fminf(x1 - x0, limit));
+  boxHeight = int(fminf(y1 - y0, limit));
 }
 
 // A mask's per-vertex values, and what the raster writes per pixel (null pointers: nothing).

@@ -31,7 +31,9 @@ struct TaaView {
   TaaParams params;
 };
 
-PVR_HOST_DEVICE inline Vec3 clampedPixel(const Vec3* image, int width, int height, int x, int y) {
+// Pixel (x, y) of a colour or depth image, the nearest edge pixel outside it.
+template <class T>
+PVR_HOST_DEVICE inline T clampedPixel(const T* image, int width, int height, int x, int y) {
   x = x < 0 ? 0 : (x >= width ? width - 1 : x);
   y = y < 0 ? 0 : (y >= height ? height - 1 : y);
   return image[size_t(y) * width + x];
@@ -108,9 +110,7 @@ PVR_HOST_DEVICE inline bool previousSawSameSurface(const TaaView& v, float px, f
     bool near = false;
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 2; ++i) {
-        int x = x0 + i < 0 ? 0 : (x0 + i >= w ? w - 1 : x0 + i);
-        int y = y0 + j < 0 ? 0 : (y0 + j >= h ? h - 1 : y0 + j);
-        float d = v.historyInverseDepth[size_t(y) * w + x];
+        float d = clampedPixel(v.historyInverseDepth, w, h, x0 + i, y0 + j);
         near = near || fabsf(d - expected) <= tolerance * fmaxf(d, expected);
         bilinear += d * (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
       }
@@ -122,10 +122,7 @@ PVR_HOST_DEVICE inline bool previousSawSameSurface(const TaaView& v, float px, f
   float lo = INFINITY, hi = 0.0f;
   for (int j = -1; j <= 1; ++j)
     for (int i = -1; i <= 1; ++i) {
-      int x = cx + i * step, y = cy + j * step;
-      x = x < 0 ? 0 : (x >= w ? w - 1 : x);
-      y = y < 0 ? 0 : (y >= h ? h - 1 : y);
-      float d = v.historyInverseDepth[size_t(y) * w + x];
+      float d = clampedPixel(v.historyInverseDepth, w, h, cx + i * step, cy + j * step);
       lo = fminf(lo, d);
       hi = fmaxf(hi, d);
     }
