@@ -272,8 +272,8 @@ __global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, Ga
   MaskPoint o = mask.offsets[vertex];
   const float px = o.x + float(gazeX) + 0.5f, py = o.y + float(gazeY) + 0.5f;
   if constexpr (R == StereoRole::Alone) {
-    float inverseDepth;  // a local: storing through the pointer mid-path costs registers
-    points[vertex] = imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, &inverseDepth);
+    float inverseDepth;  // a local: storing to global memory mid-path costs registers
+    points[vertex] = imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, inverseDepth);
     inverseDepths[vertex] = inverseDepth;
   } else {
     PixelSample sample;

@@ -128,30 +128,22 @@ PVR_HOST_DEVICE inline float firstHitInverseDepth(const EyeCamera& camera, const
 
 // The gather point seen through a continuous image position (a foveation mask's vertex), with the
 // random numbers of the pixel it lies in: a vertex on a pixel centre is shaded exactly as that
-// pixel's first sample. Positions outside the image get streams of their own. `inverseDepth`, if
-// given, receives the first hit's (for temporal reprojection).
+// pixel's first sample. Positions outside the image get streams of their own. `inverseDepth`
+// receives the first hit's (for temporal reprojection).
 template <class Intersector>
 PVR_HOST_DEVICE GatherPoint imagePositionGatherPoint(const SceneView& scene, const Intersector& intersector,
                                                      const GatherParams& params, const EyeCamera& camera, Eye eye,
-                                                     float px, float py, float* inverseDepth = nullptr) {
+                                                     float px, float py, float& inverseDepth) {
   int ix = int(floorf(px)), iy = int(floorf(py));
   bool inside = ix >= 0 && iy >= 0 && ix < camera.width && iy < camera.height;
   uint32_t stream = inside ? uint32_t(iy) * uint32_t(camera.width) + uint32_t(ix)
                            : hashCombine(hashCombine(0x9e3779b9u, uint32_t(ix)), uint32_t(iy)) | 0x80000000u;
   CounterRng rng = pixelRng(params, eye, stream, 0);
   Ray ray = camera.generateRay(px, py);
-  if (!inverseDepth) return traceToDiffuse(scene, intersector, params, ray, rng);
   Hit first;
   intersector.intersect(ray, INFINITY, first);
-  *inverseDepth = firstHitInverseDepth(camera, ray, first);
+  inverseDepth = firstHitInverseDepth(camera, ray, first);
   return traceToDiffuse(scene, intersector, params, ray, rng, &first);
-}
-
-template <class Intersector, class PhotonMap>
-PVR_HOST_DEVICE Vec3 shadeImagePosition(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
-                                        const GatherParams& params, const EyeCamera& camera, Eye eye, float px,
-                                        float py) {
-  return finishGather(map, imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py), params.density);
 }
 
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
@@ -213,7 +205,7 @@ PVR_HOST_DEVICE GatherPoint vertexGatherPoint(const SceneView& scene, const Inte
     return pixelGatherPoint(scene, intersector, params, camera, eye, x, y, 0, reuse, sample,
                             surfaces ? surfaces + size_t(y) * camera.width + x : nullptr);
   }
-  return imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, &sample.inverseDepth);
+  return imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, sample.inverseDepth);
 }
 
 // Pixel (x, y) of one eye: the average of samplesPerPixel jittered rays, or the other eye's
