@@ -9,14 +9,17 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "pvr/app/options.h"
+#include "pvr/cpu/cpu_backend.h"
 #include "pvr/foveation/mask.h"
-#include "pvr/render/image_compare.h"
+#include "pvr/image/image_compare.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "bench_util.h"
 #include "pvr/util/error.h"
 #ifdef PVR_HAVE_CUDA
-#include "pvr/cuda/cuda_renderer.h"
+#include "gpu_ray_throughput.h"
+#include "pvr/cuda/cuda_frame_backend.h"
 #endif
 
 namespace pvr {
@@ -288,7 +291,7 @@ int runStereo(const FrameBenchArgs& args, FrameRenderer& renderer, nlohmann::jso
         failures += ok ? 0 : 1;
         double reuse = double(cell.last.reusedPixels) / (double(rig.width) * rig.height);
         double surface = 0;  // right-eye pixels that see a surface (the rest is background)
-        for (uint32_t prim : reference.eyes[1].firstPrim) surface += prim != ~0u ? 1.0 : 0.0;
+        for (uint32_t prim : reference.eyes[1].firstPrim.value()) surface += prim != ~0u ? 1.0 : 0.0;
         double reuseOfSurface = surface > 0 ? double(cell.last.reusedPixels) / surface : 0.0;
         double ratio = cell.eyeMs[0] > 0 ? cell.eyeMs[1] / cell.eyeMs[0] : 0.0;
         char psnr[32], line[512];
@@ -510,8 +513,8 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
   for (const std::string& name : splitList(args.raysScene)) {
     Scene scene = loadScene(name);
     StereoRig rig = benchRig(scene, args);
-    CudaFrameRenderer gpu(scene);
-    GpuRayThroughput t = gpu.measureRays(rig, 20);
+    CudaFrameBackend gpu(scene);
+    GpuRayThroughput t = measureGpuRays(gpu, rig, 20);
     // Check: the left eye's pixel-centre hits against Embree on the CPU, every 13th pixel.
     CpuBackend cpu(scene);
     EyeCamera camera = rig.eye(Eye::Left);
@@ -548,11 +551,11 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
 
 int runGrid(const FrameBenchArgs& args, nlohmann::json& json) {
   Scene scene = loadScene(args.scene);
-  CudaFrameRenderer gpu(scene);
+  CudaFrameBackend gpu(scene);
   PhotonTraceParams params;
   params.photonCount = 1u << 20;
   params.storeDirect = true;
-  std::vector<Photon> photons = gpu.tracePhotons(params);
+  std::vector<Photon> photons = gpu.tracePhotonsToHost(params);
   photons.resize(std::min<size_t>(photons.size(), 1u << 20));
   int failures = 0;
   std::printf("\nHash-grid build on the GPU: %zu photons traced in %s; keys, CUB radix sort of (cell, index), "

@@ -1,7 +1,6 @@
 #include "map_bench.h"
 
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cmath>
@@ -12,6 +11,7 @@
 #include "pvr/cpu/cpu_backend.h"
 #include "bench_util.h"
 #include "pvr/util/error.h"
+#include "pvr/util/parallel_for.h"
 
 namespace pvr {
 namespace {
@@ -65,8 +65,8 @@ std::vector<QueryPoint> eyeHitPoints(const CpuBackend& backend, const StereoRig&
 
 template <class Map>
 void estimateAll(const Map& map, const std::vector<QueryPoint>& q, const DensityParams& p, std::vector<Vec3>& out) {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, q.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) out[i] = estimateFluxDensity(map, q[i].position, q[i].normal, p);
+  parallelFor("map queries", q.size(), 64, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) out[i] = estimateFluxDensity(map, q[i].position, q[i].normal, p);
   });
 }
 

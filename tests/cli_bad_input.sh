@@ -47,7 +47,7 @@ expect_error "--acuity must be" mask --acuity eagle --out "$out/m.pvrmask"
 expect_error "--margin must be" mask --margin -2 --out "$out/m.pvrmask"
 expect_error "--eye-size" mask --eye-size 0x5 --out "$out/m.pvrmask"
 expect_error "cannot write" mask --eye-size 32x32 --out /dev/null/m.pvrmask
-expect_error "--gaze must be" render cornell --foveated --gaze 2,0.5 --eye-size 8x8
+expect_error "--gaze: the gaze must lie in the image" render cornell --foveated --gaze 2,0.5 --eye-size 8x8
 expect_error "--gaze must be" render cornell --foveated --gaze 0.5 --eye-size 8x8
 expect_error "cannot open mask file" render cornell --foveated --mask "$data/missing.pvrmask" --eye-size 8x8
 expect_error "not a photonvr mask" render cornell --foveated --mask "$data/box.obj" --eye-size 8x8
@@ -57,8 +57,8 @@ expect_error "mask is for 32x32" render cornell --foveated --mask "$out/m32.pvrm
 expect_error "cannot open trajectory" render cornell --trajectory "$data/missing.txt" --eye-size 8x8
 expect_error "line 2: .mtllib. is not a number" render cornell --trajectory "$data/box.obj" --eye-size 8x8
 expect_error "--taa-blend is for --taa" render cornell --taa-blend 0.5 --eye-size 8x8
-expect_error "--taa-blend must be in (0, 1\]" render cornell --taa --taa-blend 0 --eye-size 8x8
-expect_error "--taa-blend must be in (0, 1\]" render cornell --taa --taa-blend 1.5 --eye-size 8x8
+expect_error "--taa-blend: the TAA blend must be in (0, 1\]" render cornell --taa --taa-blend 0 --eye-size 8x8
+expect_error "--taa-blend: the TAA blend must be in (0, 1\]" render cornell --taa --taa-blend 1.5 --eye-size 8x8
 expect_error "--taa-blend" render cornell --taa --taa-blend nan --eye-size 8x8
 expect_error "--taa-blend" render cornell --taa --taa-blend 0.5x --eye-size 8x8
 expect_error "--suite must be" bench --suite speed
@@ -66,7 +66,7 @@ expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1
 expect_error "photons must be" render cornell --photons 0x256 --eye-size 8x8
 expect_error "photons" render cornell --photons -5 --eye-size 8x8
-expect_error "too large" render cornell --photons 100000x100000 --eye-size 8x8
+expect_error "--photons: too many photons" render cornell --photons 100000x100000 --eye-size 8x8
 expect_error "radius" render cornell --radius 0 --eye-size 8x8
 expect_error "radius" render cornell --radius -0.1 --eye-size 8x8
 expect_error "radius" render cornell --radius nan --eye-size 8x8
@@ -75,7 +75,12 @@ expect_error "radius" render cornell --radius abc --eye-size 8x8
 expect_error "eye-size" render cornell --eye-size 0x0
 expect_error "eye-size" render cornell --eye-size 100000x100000
 expect_error "eye-size" render cornell --eye-size 12
-expect_error "ipd" render cornell --ipd -1 --eye-size 8x8
+expect_error "--ipd: the IPD must be" render cornell --ipd -1 --eye-size 8x8
+expect_error "--ipd: the IPD must be" render cornell --ipd inf --eye-size 8x8
+expect_error "--spp: samples per pixel" render cornell --spp 5000 --eye-size 8x8
+expect_error "--photon-depth: the photon depth" render cornell --photon-depth 0 --eye-size 8x8
+expect_error "--specular-depth: the specular depth" render cornell --specular-depth 65 --eye-size 8x8
+expect_error "--photons: too many photons" render cornell --photons 8193x8192 --eye-size 8x8
 expect_error "--k" render cornell --estimator knn --k 0 --eye-size 8x8
 expect_error "--k" render cornell --estimator knn --k 65 --eye-size 8x8
 expect_error "--map" render cornell --map octree --eye-size 8x8

@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/render/renderer.h"
 
 namespace pvr {
@@ -37,9 +38,9 @@ std::map<std::string, Vec3> meanPerMesh(const Scene& scene, const FrameResult& f
   const char* eyeNames[2] = {"left", "right"};
   for (int e = 0; e < 2; ++e) {
     const EyeResult& eye = frame.eyes[e];
-    for (size_t i = 0; i < eye.firstPrim.size(); ++i) {
-      if (eye.firstPrim[i] == ~0u) continue;
-      std::string key = std::string(eyeNames[e]) + "/" + scene.meshes()[scene.meshOfTriangle(eye.firstPrim[i])].name;
+    for (size_t i = 0; i < eye.firstPrim->size(); ++i) {
+      if (eye.firstPrim.value()[i] == ~0u) continue;
+      std::string key = std::string(eyeNames[e]) + "/" + scene.meshes()[scene.meshOfTriangle(eye.firstPrim.value()[i])].name;
       sum[key] += eye.image.pixels[i];
       ++count[key];
     }
@@ -52,8 +53,8 @@ std::map<std::string, Vec3> meanPerMesh(const Scene& scene, const FrameResult& f
 const std::map<std::string, Vec3>& referenceMeans() {
   static const std::map<std::string, Vec3> means = [] {
     Scene scene = builtinScene("cornell");
-    CpuBackend backend(scene);
-    return meanPerMesh(scene, renderFrame(backend, referenceRig(scene), referenceOptions()));
+    FrameRenderer renderer = makeCpuFrameRenderer(scene);
+    return meanPerMesh(scene, renderer.render(referenceRig(scene), referenceOptions()));
   }();
   return means;
 }
@@ -98,15 +99,15 @@ TEST(CornellRegression, ColourBleedingAndLighting) {
 
 TEST(CornellRegression, KdTreeAndHashGridRenderTheSameImage) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   StereoRig rig = referenceRig(scene);
   rig.width = 72;
   rig.height = 80;
   RenderOptions o = referenceOptions();
   o.gather.samplesPerPixel = 1;
-  FrameResult grid = renderFrame(backend, rig, o);
+  FrameResult grid = renderer.render(rig, o);
   o.map = PhotonMapKind::KdTree;
-  FrameResult tree = renderFrame(backend, rig, o);
+  FrameResult tree = renderer.render(rig, o);
   for (int e = 0; e < 2; ++e)
     for (size_t i = 0; i < grid.eyes[e].image.pixels.size(); ++i)
       for (int c = 0; c < 3; ++c) {
@@ -119,15 +120,15 @@ TEST(CornellRegression, KnnAndRadiusEstimatesAgreeOnAverage) {
   // Both estimate the same irradiance: per-wall means agree within a few percent (kNN is blurrier
   // or sharper locally, not brighter).
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   RenderOptions o = referenceOptions();
   o.gather.samplesPerPixel = 2;
   o.gather.mode = ShadingMode::PhotonMapOnly;
-  auto radius = meanPerMesh(scene, renderFrame(backend, referenceRig(scene), o));
+  auto radius = meanPerMesh(scene, renderer.render(referenceRig(scene), o));
   o.gather.density.estimator = Estimator::Knn;
   o.gather.density.k = 64;
   o.gather.density.radius = 0.2f;
-  auto knn = meanPerMesh(scene, renderFrame(backend, referenceRig(scene), o));
+  auto knn = meanPerMesh(scene, renderer.render(referenceRig(scene), o));
   for (const char* wall : {"left/back wall", "left/floor", "right/red wall", "right/green wall"})
     EXPECT_NEAR(luminance(knn[wall]), luminance(radius[wall]), 0.1f * luminance(radius[wall])) << wall;
 }

@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "pvr/foveation/mask.h"
+#include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/render/renderer.h"
 #include "pvr/util/error.h"
 
@@ -253,7 +254,7 @@ TEST(FoveationMask, RejectsBadParameters) {
 
 TEST(FoveatedRender, TheFoveaIsTheFullResolutionImageAndFewerSamplesAreShaded) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   StereoRig rig = scene.rig;
   rig.width = 160, rig.height = 176;
   MaskParams params = maskParamsForRig(rig);
@@ -262,10 +263,10 @@ TEST(FoveatedRender, TheFoveaIsTheFullResolutionImageAndFewerSamplesAreShaded) {
   RenderOptions o;
   o.photonsX = o.photonsY = 96;
   o.gather.density.radius = 0.06f;
-  FrameResult full = renderFrame(backend, rig, o);
+  FrameResult full = renderer.render(rig, o);
   o.foveation.mask = &mask;
   o.foveation.gaze[0][0] = 0.4f, o.foveation.gaze[0][1] = 0.55f;
-  FrameResult foveated = renderFrame(backend, rig, o);
+  FrameResult foveated = renderer.render(rig, o);
   for (int e = 0; e < 2; ++e) {
     int gx, gy;
     o.foveation.gazePixel(e, rig.width, rig.height, gx, gy);
@@ -283,13 +284,14 @@ TEST(FoveatedRender, TheFoveaIsTheFullResolutionImageAndFewerSamplesAreShaded) {
   }
   // A mask for another eye size is refused.
   rig.width = 150;
-  EXPECT_THROW(renderFrame(backend, rig, o), Error);
+  EXPECT_THROW(renderer.render(rig, o), Error);
 }
 
 // With one gaze for both eyes, the right eye looks at the surface point the left eye fixates.
 TEST(FoveatedRender, VergedEyesFixateTheSamePoint) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  const CpuBackend& backend = renderer.backendAs<CpuFrameBackend>().backend();
   StereoRig rig = scene.rig;
   rig.width = 160, rig.height = 176;
   rig.ipd = 0.2f;  // a wide baseline: a large disparity
@@ -302,7 +304,7 @@ TEST(FoveatedRender, VergedEyesFixateTheSamePoint) {
   o.foveation.verge = true;
   for (float gx : {0.3f, 0.5f, 0.62f}) {
     o.foveation.gaze[0][0] = gx, o.foveation.gaze[0][1] = 0.55f;
-    FrameResult frame = renderFrame(backend, rig, o);
+    FrameResult frame = renderer.render(rig, o);
     EXPECT_EQ(frame.gaze[0][0], gx);
     Vec3 fixated[2];
     for (int e = 0; e < 2; ++e) {

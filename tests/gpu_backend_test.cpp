@@ -5,7 +5,9 @@
 
 #include <cmath>
 
-#include "pvr/cuda/cuda_renderer.h"
+#include "gpu_ray_throughput.h"
+#include "pvr/cpu/cpu_frame_backend.h"
+#include "pvr/cuda/cuda_frame_backend.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
@@ -37,10 +39,9 @@ double relativeDifference(const std::vector<T>& reference, const std::vector<T>&
 struct BothBackends {
   Scene scene;
   StereoRig rig;
-  CpuFrameRenderer cpu;
-  CudaFrameRenderer gpu;
+  FrameRenderer cpu, gpu;
   BothBackends(const char* name, int width = 0, int height = 0)
-      : scene(builtinScene(name)), rig(scene.rig), cpu(scene), gpu(scene) {
+      : scene(builtinScene(name)), rig(scene.rig), cpu(makeCpuFrameRenderer(scene)), gpu(makeCudaFrameRenderer(scene)) {
     if (width) rig.width = width, rig.height = height;
   }
 };
@@ -65,11 +66,11 @@ TEST(GpuBackend, StoredPhotonsMatchTheCpu) {
     for (bool storeDirect : {false, true}) {
       Scene scene = builtinScene(name);
       CpuBackend cpu(scene);
-      CudaFrameRenderer gpu(scene);
+      CudaFrameBackend gpu(scene);
       PhotonTraceParams params;
       params.photonCount = 128 * 128;
       params.storeDirect = storeDirect;
-      std::vector<Photon> a = cpu.tracePhotons(params), b = gpu.tracePhotons(params);
+      std::vector<Photon> a = cpu.tracePhotons(params), b = gpu.tracePhotonsToHost(params);
       ASSERT_EQ(a.size(), b.size()) << name << " storeDirect " << storeDirect;
       size_t far = 0;
       for (size_t i = 0; i < a.size(); ++i) {
@@ -88,11 +89,11 @@ TEST(GpuBackend, StoredPhotonsMatchTheCpu) {
 TEST(GpuBackend, HashGridMatchesTheCpuBuildExactly) {
   PVR_REQUIRE_GPU();
   Scene scene = builtinScene("cornell");
-  CudaFrameRenderer gpu(scene);
+  CudaFrameBackend gpu(scene);
   PhotonTraceParams params;
   params.photonCount = 256 * 256;
   params.storeDirect = true;
-  std::vector<Photon> photons = gpu.tracePhotons(params);
+  std::vector<Photon> photons = gpu.tracePhotonsToHost(params);
   for (float radius : {0.02f, 0.05f, 0.2f}) {
     GpuHashGridCopy copy;
     gpu.buildHashGrid(photons, radius, 1, &copy);
@@ -115,7 +116,7 @@ ImageCheck compare(const FrameResult& a, const FrameResult& b) {
   for (int e = 0; e < 2; ++e) {
     d.add(a.eyes[e].image.pixels, b.eyes[e].image.pixels);
     n += a.eyes[e].image.pixels.size();
-    for (size_t i = 0; i < a.eyes[e].firstPrim.size(); ++i) same += a.eyes[e].firstPrim[i] == b.eyes[e].firstPrim[i] ? 1 : 0;
+    for (size_t i = 0; i < a.eyes[e].firstPrim->size(); ++i) same += a.eyes[e].firstPrim.value()[i] == b.eyes[e].firstPrim.value()[i] ? 1 : 0;
   }
   double mean = d.sum / (3.0 * n);
   for (int e = 0; e < 2; ++e) {
@@ -187,7 +188,7 @@ TEST(GpuBackend, StereoReuseMatchesTheCpu) {
           ImageCheck c = compare(reference, frame);
           EXPECT_LT(c.relativeMad, 0.01) << what;
           EXPECT_LT(c.outliers, 0.005) << what;
-          const auto &a = reference.eyes[1].reusedFrom, &b = frame.eyes[1].reusedFrom;
+          const auto &a = reference.eyes[1].reusedFrom.value(), &b = frame.eyes[1].reusedFrom.value();
           ASSERT_EQ(a.size(), b.size()) << what;
           size_t same = 0, reused = 0;
           for (size_t i = 0; i < a.size(); ++i) {
@@ -223,8 +224,8 @@ TEST(GpuBackend, FoveatedImagesMatchTheCpu) {
       EXPECT_EQ(a.shadedSamples[e], b.shadedSamples[e]);
       EXPECT_LT(relativeDifference(a.eyes[e].image.pixels, b.eyes[e].image.pixels), 0.01) << "eye " << e << what;
       EXPECT_LT(relativeDifference(a.eyes[e].inverseDepth, b.eyes[e].inverseDepth), 1e-3) << "eye " << e << what;
-      EXPECT_LT(relativeDifference(a.eyes[e].sampleSpacing, b.eyes[e].sampleSpacing), 1e-6) << "eye " << e << what;
-      EXPECT_TRUE(a.eyes[e].firstPrim.empty() && b.eyes[e].firstPrim.empty()) << "foveated frames have no first-hit ids";
+      EXPECT_LT(relativeDifference(a.eyes[e].sampleSpacing.value(), b.eyes[e].sampleSpacing.value()), 1e-6) << "eye " << e << what;
+      EXPECT_TRUE(!a.eyes[e].firstPrim && !b.eyes[e].firstPrim) << "foveated frames have no first-hit ids";
     }
   }
   // Stereo reuse per vertex, with the eyes verged on one point: the right eye's gaze and the
@@ -303,8 +304,8 @@ TEST(GpuBackend, RayTraversalAgreesWithEmbree) {
     Scene scene = builtinScene(name);
     StereoRig rig = scene.rig;
     rig.width = 320, rig.height = 352;
-    CudaFrameRenderer gpu(scene);
-    GpuRayThroughput t = gpu.measureRays(rig, 1);
+    CudaFrameBackend gpu(scene);
+    GpuRayThroughput t = measureGpuRays(gpu, rig, 1);
     CpuBackend cpu(scene);
     EyeCamera camera = rig.eye(Eye::Left);
     size_t agree = 0;

@@ -7,7 +7,9 @@
 #include <cmath>
 
 #include "pvr/foveation/mask.h"
-#include "pvr/render/image_compare.h"
+#include "pvr/image/image_compare.h"
+#include "pvr/app/options.h"
+#include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/render/renderer.h"
 #include "pvr/util/error.h"
 
@@ -33,26 +35,27 @@ RenderOptions stereoOptions(StereoMode mode, ShadingMode shading = ShadingMode::
 
 size_t countReused(const EyeResult& eye) {
   size_t n = 0;
-  for (uint32_t s : eye.reusedFrom) n += s != kNotReused ? 1 : 0;
+  for (uint32_t s : *eye.reusedFrom) n += s != kNotReused ? 1 : 0;
   return n;
 }
 
 // The pixels the right eye shaded itself must be those of separate rendering, bit for bit.
 void expectShadedPixelsEqualSeparate(const FrameResult& reused, const FrameResult& separate) {
   const EyeResult& r = reused.eyes[1];
-  ASSERT_EQ(r.reusedFrom.size(), r.image.pixels.size());
+  ASSERT_EQ(r.reusedFrom->size(), r.image.pixels.size());
   size_t differing = 0;
   for (size_t i = 0; i < r.image.pixels.size(); ++i) {
-    if (r.reusedFrom[i] != kNotReused) continue;
+    if (r.reusedFrom.value()[i] != kNotReused) continue;
     const Vec3 &a = r.image.pixels[i], &b = separate.eyes[1].image.pixels[i];
-    differing += (a.x != b.x || a.y != b.y || a.z != b.z || r.firstPrim[i] != separate.eyes[1].firstPrim[i]) ? 1 : 0;
+    differing += (a.x != b.x || a.y != b.y || a.z != b.z || r.firstPrim.value()[i] != separate.eyes[1].firstPrim.value()[i]) ? 1 : 0;
   }
   EXPECT_EQ(differing, 0u);
 }
 
 TEST(StereoReuse, ReprojectionRoundTripBetweenEyes) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  const CpuBackend& backend = renderer.backendAs<CpuFrameBackend>().backend();
   StereoRig rig = smallRig(scene);
   EyeCamera left = rig.eye(Eye::Left), right = rig.eye(Eye::Right);
   const EmbreeIntersector& embree = backend.intersector();
@@ -82,9 +85,10 @@ TEST(StereoReuse, ReprojectionRoundTripBetweenEyes) {
 
 TEST(StereoReuse, ScatterNeverWritesAPointHiddenFromTheRightEye) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  const CpuBackend& backend = renderer.backendAs<CpuFrameBackend>().backend();
   StereoRig rig = smallRig(scene, 0.4f);  // a wide baseline hides much of what the left eye sees
-  FrameResult frame = renderFrame(backend, rig, stereoOptions(StereoMode::Scatter));
+  FrameResult frame = renderer.render(rig, stereoOptions(StereoMode::Scatter));
   EyeCamera left = rig.eye(Eye::Left), right = rig.eye(Eye::Right);
   const EmbreeIntersector& embree = backend.intersector();
   auto leftPoint = [&](uint32_t pixel, Vec3& p) {
@@ -110,47 +114,47 @@ TEST(StereoReuse, ScatterNeverWritesAPointHiddenFromTheRightEye) {
   EXPECT_GT(hidden, 200u);
   const EyeResult& r = frame.eyes[1];
   size_t reused = 0;
-  for (size_t i = 0; i < r.reusedFrom.size(); ++i) {
-    if (r.reusedFrom[i] == kNotReused) continue;
+  for (size_t i = 0; i < r.reusedFrom->size(); ++i) {
+    if (r.reusedFrom.value()[i] == kNotReused) continue;
     ++reused;
     Vec3 p;
-    ASSERT_TRUE(leftPoint(r.reusedFrom[i], p));
-    ASSERT_TRUE(visibleFromRight(p)) << "right pixel " << i << " took hidden left pixel " << r.reusedFrom[i];
+    ASSERT_TRUE(leftPoint(r.reusedFrom.value()[i], p));
+    ASSERT_TRUE(visibleFromRight(p)) << "right pixel " << i << " took hidden left pixel " << r.reusedFrom.value()[i];
     float rx, ry;
     ASSERT_TRUE(right.project(p, rx, ry));
     EXPECT_EQ(size_t(ry) * right.width + size_t(rx), i) << "a left point lands on the pixel it projects to";
   }
   EXPECT_EQ(reused, frame.reusedPixels);
-  EXPECT_GT(reused, r.reusedFrom.size() / 4);
+  EXPECT_GT(reused, r.reusedFrom->size() / 4);
 }
 
 TEST(StereoReuse, NothingSeenThroughMirrorsOrGlassIsReused) {
   Scene scene = builtinScene("cornell-caustics");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   StereoRig rig = smallRig(scene);
-  FrameResult separate = renderFrame(backend, rig, stereoOptions(StereoMode::Separate));
+  FrameResult separate = renderer.render(rig, stereoOptions(StereoMode::Separate));
   auto specular = [&](uint32_t prim) { return prim != ~0u && scene.materials()[scene.view().materialIds[prim]].isSpecular(); };
   for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
     SCOPED_TRACE(stereoModeName(mode));
-    FrameResult frame = renderFrame(backend, rig, stereoOptions(mode));
+    FrameResult frame = renderer.render(rig, stereoOptions(mode));
     const EyeResult& r = frame.eyes[1];
     size_t specularPixels = 0, scatteredOntoSpecular = 0;
-    for (size_t i = 0; i < r.reusedFrom.size(); ++i) {
-      specularPixels += specular(separate.eyes[1].firstPrim[i]) ? 1 : 0;
-      if (r.reusedFrom[i] == kNotReused) continue;
-      ASSERT_FALSE(specular(frame.eyes[0].firstPrim[r.reusedFrom[i]])) << "left pixel sees a mirror or glass";
+    for (size_t i = 0; i < r.reusedFrom->size(); ++i) {
+      specularPixels += specular(separate.eyes[1].firstPrim.value()[i]) ? 1 : 0;
+      if (r.reusedFrom.value()[i] == kNotReused) continue;
+      ASSERT_FALSE(specular(frame.eyes[0].firstPrim.value()[r.reusedFrom.value()[i]])) << "left pixel sees a mirror or glass";
       // Gather decides from the right pixel's own first hit. Scatter cannot know what a right
       // pixel's centre sees: a left point visible from the right eye may land on a pixel whose
       // centre just grazes a sphere's silhouette (the paper's scheme; counted below).
       if (mode == StereoMode::Gather) {
-        ASSERT_FALSE(specular(separate.eyes[1].firstPrim[i])) << "right pixel " << i << " sees a mirror or glass";
+        ASSERT_FALSE(specular(separate.eyes[1].firstPrim.value()[i])) << "right pixel " << i << " sees a mirror or glass";
       } else {
-        scatteredOntoSpecular += specular(separate.eyes[1].firstPrim[i]) ? 1 : 0;
+        scatteredOntoSpecular += specular(separate.eyes[1].firstPrim.value()[i]) ? 1 : 0;
       }
     }
     EXPECT_GT(specularPixels, 300u);  // the spheres fill a good part of the view
     EXPECT_LE(scatteredOntoSpecular, specularPixels / 10);
-    EXPECT_GT(countReused(r), r.reusedFrom.size() / 3);
+    EXPECT_GT(countReused(r), r.reusedFrom->size() / 3);
     // Reflections and refractions are the right eye's own: exactly the separate rendering.
     expectShadedPixelsEqualSeparate(frame, separate);
   }
@@ -158,29 +162,29 @@ TEST(StereoReuse, NothingSeenThroughMirrorsOrGlassIsReused) {
 
 TEST(StereoReuse, ZeroIpdReusesEveryPixelAndGivesIdenticalImages) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   StereoRig rig = smallRig(scene, 0.0f);
   rig.fov[1] = rig.fov[0];
   for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
     SCOPED_TRACE(stereoModeName(mode));
-    FrameResult frame = renderFrame(backend, rig, stereoOptions(mode));
+    FrameResult frame = renderer.render(rig, stereoOptions(mode));
     const EyeResult &l = frame.eyes[0], &r = frame.eyes[1];
     size_t surfacePixels = 0, reusedInPlace = 0;
-    for (size_t i = 0; i < l.firstPrim.size(); ++i) {
-      if (l.firstPrim[i] == ~0u) {  // the open front of the box: background, black in both eyes
-        ASSERT_EQ(r.reusedFrom[i], kNotReused);
+    for (size_t i = 0; i < l.firstPrim->size(); ++i) {
+      if (l.firstPrim.value()[i] == ~0u) {  // the open front of the box: background, black in both eyes
+        ASSERT_EQ(r.reusedFrom.value()[i], kNotReused);
         ASSERT_TRUE(isBlack(r.image.pixels[i]) && isBlack(l.image.pixels[i]));
         continue;
       }
       ++surfacePixels;
-      if (r.reusedFrom[i] != kNotReused) {
-        ASSERT_EQ(r.reusedFrom[i], uint32_t(i)) << "pixel " << i << " took another pixel's shading";
+      if (r.reusedFrom.value()[i] != kNotReused) {
+        ASSERT_EQ(r.reusedFrom.value()[i], uint32_t(i)) << "pixel " << i << " took another pixel's shading";
         ASSERT_TRUE(r.image.pixels[i].x == l.image.pixels[i].x && r.image.pixels[i].y == l.image.pixels[i].y &&
                     r.image.pixels[i].z == l.image.pixels[i].z);
         ++reusedInPlace;
       }
     }
-    EXPECT_GT(surfacePixels, l.firstPrim.size() / 3);
+    EXPECT_GT(surfacePixels, l.firstPrim->size() / 3);
     EXPECT_EQ(frame.reusedPixels, reusedInPlace);
     // Gather compares the very same hit: every surface pixel. Scatter's visibility ray back to the
     // eye may clip an edge it grazes, in float: a handful of pixels are then shaded again.
@@ -191,18 +195,18 @@ TEST(StereoReuse, ZeroIpdReusesEveryPixelAndGivesIdenticalImages) {
 
 TEST(StereoReuse, HugeIpdReusesAlmostNothingAndEqualsSeparateRendering) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   // The right eye 1.5 m to the side sees the outside of the box's right wall, the left eye its
   // inside: same triangles, opposite sides, nothing to share.
   StereoRig rig = smallRig(scene, 3.0f);
-  FrameResult separate = renderFrame(backend, rig, stereoOptions(StereoMode::Separate));
+  FrameResult separate = renderer.render(rig, stereoOptions(StereoMode::Separate));
   size_t rightSurface = 0;
-  for (uint32_t p : separate.eyes[1].firstPrim) rightSurface += p != ~0u ? 1 : 0;
-  EXPECT_GT(rightSurface, separate.eyes[1].firstPrim.size() / 20) << "the right eye must see the box";
+  for (uint32_t p : *separate.eyes[1].firstPrim) rightSurface += p != ~0u ? 1 : 0;
+  EXPECT_GT(rightSurface, separate.eyes[1].firstPrim->size() / 20) << "the right eye must see the box";
   for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
     SCOPED_TRACE(stereoModeName(mode));
-    FrameResult frame = renderFrame(backend, rig, stereoOptions(mode));
-    EXPECT_LE(frame.reusedPixels, frame.eyes[1].reusedFrom.size() / 100);
+    FrameResult frame = renderer.render(rig, stereoOptions(mode));
+    EXPECT_LE(frame.reusedPixels, frame.eyes[1].reusedFrom->size() / 100);
     expectShadedPixelsEqualSeparate(frame, separate);
     ImageComparison c = compareDisplayed(frame.eyes[1].image, separate.eyes[1].image);
     EXPECT_GE(c.psnr, 40.0);
@@ -213,13 +217,13 @@ TEST(StereoReuse, GatherIsInvisibleOnTheCornellBox) {
   // The paper's photon-map-only shading is deterministic given the map: the right eye rendered
   // with reuse differs from its separate rendering only by sub-pixel position.
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   StereoRig rig = smallRig(scene);
-  FrameResult separate = renderFrame(backend, rig, stereoOptions(StereoMode::Separate, ShadingMode::PhotonMapOnly));
-  FrameResult gather = renderFrame(backend, rig, stereoOptions(StereoMode::Gather, ShadingMode::PhotonMapOnly));
-  FrameResult scatter = renderFrame(backend, rig, stereoOptions(StereoMode::Scatter, ShadingMode::PhotonMapOnly));
+  FrameResult separate = renderer.render(rig, stereoOptions(StereoMode::Separate, ShadingMode::PhotonMapOnly));
+  FrameResult gather = renderer.render(rig, stereoOptions(StereoMode::Gather, ShadingMode::PhotonMapOnly));
+  FrameResult scatter = renderer.render(rig, stereoOptions(StereoMode::Scatter, ShadingMode::PhotonMapOnly));
   size_t surfacePixels = 0;
-  for (uint32_t p : separate.eyes[1].firstPrim) surfacePixels += p != ~0u ? 1 : 0;
+  for (uint32_t p : *separate.eyes[1].firstPrim) surfacePixels += p != ~0u ? 1 : 0;
   EXPECT_GT(double(gather.reusedPixels), 0.9 * double(surfacePixels));
   EXPECT_GT(double(scatter.reusedPixels), 0.8 * double(surfacePixels));
   expectShadedPixelsEqualSeparate(gather, separate);
@@ -241,7 +245,7 @@ TEST(StereoReuse, GatherIsInvisibleOnTheCornellBox) {
 // region) may take the shading of the left pixel that a left vertex recorded.
 TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   StereoRig rig = smallRig(scene);
   MaskParams params = maskParamsForRig(rig);
   params.tanPerPixel *= 9.0f;  // a coarse pixel: the headset's falloff on a small image
@@ -253,7 +257,7 @@ TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
     o.foveation.mask = &mask;
     RenderOptions separateOptions = o;
     separateOptions.stereo = StereoMode::Separate;
-    FrameResult reused = renderFrame(backend, rig, o), separate = renderFrame(backend, rig, separateOptions);
+    FrameResult reused = renderer.render(rig, o), separate = renderer.render(rig, separateOptions);
     // The candidates: right vertices on pixel centres that see a surface (all diffuse here).
     auto candidatesOf = [&](const FrameResult& frame) {
       FoveationOptions f;
@@ -278,12 +282,12 @@ TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
     EXPECT_GT(double(reused.reusedPixels), 0.25 * double(candidates));
     EXPECT_LE(reused.reusedPixels, candidates);
     EXPECT_EQ(reused.shadedSamples[1], separate.shadedSamples[1]);
-    EXPECT_TRUE(reused.eyes[1].reusedFrom.empty()) << "foveated reuse is per vertex";
+    EXPECT_TRUE(!reused.eyes[1].reusedFrom.has_value()) << "foveated reuse is per vertex";
     EXPECT_GE(compareDisplayed(reused.eyes[1].image, separate.eyes[1].image).psnr, 40.0);
     EXPECT_EQ(compareDisplayed(reused.eyes[0].image, separate.eyes[0].image).meanSquaredError, 0.0) << "the left eye is unaffected";
     // Eyes that fixate one point (vergence) share most of their full-density regions.
     o.foveation.verge = true;
-    FrameResult verged = renderFrame(backend, rig, o);
+    FrameResult verged = renderer.render(rig, o);
     EXPECT_GT(double(verged.reusedPixels), 0.8 * double(candidatesOf(verged)));
     EXPECT_GT(verged.reusedPixels, 2 * reused.reusedPixels);
     o.foveation.verge = false;
@@ -291,7 +295,7 @@ TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
     // value at the same position, so the right image is the left image.
     StereoRig same = smallRig(scene, 0.0f);
     same.fov[1] = same.fov[0];
-    FrameResult one = renderFrame(backend, same, o);
+    FrameResult one = renderer.render(same, o);
     EXPECT_GE(double(one.reusedPixels), 0.99 * double(candidates));
     EXPECT_EQ(compareDisplayed(one.eyes[1].image, one.eyes[0].image).meanSquaredError, 0.0);
   }
@@ -299,10 +303,10 @@ TEST(StereoReuse, FoveatedEyesReuseTheLeftVerticesShading) {
 
 TEST(StereoReuse, ReuseNeedsBothEyes) {
   Scene scene = builtinScene("cornell");
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   RenderOptions o = stereoOptions(StereoMode::Gather);
   o.eyes[0] = false;
-  EXPECT_THROW(renderFrame(backend, smallRig(scene), o), Error);
+  EXPECT_THROW(renderer.render(smallRig(scene), o), Error);
   EXPECT_THROW(parseStereoMode("both"), Error);
   EXPECT_EQ(parseStereoMode("scatter"), StereoMode::Scatter);
 }

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "pvr/cpu/cpu_renderer.h"
+#include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/render/renderer.h"
 #include "pvr/temporal/taa_history.h"
@@ -97,7 +97,7 @@ void expectConvergence(FrameRenderer& renderer, const StereoRig& rig, RenderOpti
 TEST(Temporal, StaticCameraConvergesToTheStaticImage) {
   Scene scene = builtinScene("cornell");
   StereoRig rig = smallRig(scene);
-  CpuFrameRenderer renderer(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   RenderOptions first = smallOptions(), still = smallOptions();
   first.gather.seed = 7;  // other photons: a different image
   first.photonsX = first.photonsY = 24;
@@ -111,7 +111,7 @@ TEST(Temporal, StaticCameraConvergesToTheStaticFoveatedImageAfterTheGazeMoved) {
   params.tanPerPixel *= 9.0f;  // a coarse pixel: the headset's falloff on a small image
   params.acuity.gazeMarginDeg = 3.0f;
   FoveationMask mask = generateFoveationMask(params);
-  CpuFrameRenderer renderer(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   RenderOptions first = smallOptions(), still = smallOptions();
   first.foveation.mask = still.foveation.mask = &mask;
   for (auto& g : first.foveation.gaze) g[0] = 0.2f, g[1] = 0.7f;
@@ -125,13 +125,14 @@ TEST(Temporal, StaticCameraConvergesToTheStaticFoveatedImageAfterTheGazeMoved) {
 TEST(Temporal, DisocclusionDropsHistoryWhereThePreviousEyeDidNotSeeTheSurface) {
   Scene scene = builtinScene("cornell-caustics");
   StereoRig rig = smallRig(scene, 128, 128);
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  const CpuBackend& backend = renderer.backendAs<CpuFrameBackend>().backend();
   RenderOptions o = smallOptions();
   o.eyes[1] = false;
-  FrameResult before = renderFrame(backend, rig, o);
+  FrameResult before = renderer.render(rig, o);
   StereoRig moved = rig;
   moved.head.position = rig.head.toWorldPoint({0.4f, 0.05f, -0.5f});
-  FrameResult after = renderFrame(backend, moved, o);
+  FrameResult after = renderer.render(moved, o);
   TaaView view;
   view.camera = moved.eye(Eye::Left);
   view.previousCamera = rig.eye(Eye::Left);
@@ -184,31 +185,32 @@ TEST(Temporal, DisocclusionDropsHistoryWhereThePreviousEyeDidNotSeeTheSurface) {
 TEST(Temporal, ClampingStopsGhosts) {
   Scene scene = builtinScene("cornell");
   StereoRig rig = smallRig(scene);
-  CpuBackend backend(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   RenderOptions o = smallOptions();
   o.photonsX = o.photonsY = 256;  // little noise: the neighbourhood's range is the image's, not noise
   o.gather.density.radius = 0.1f;
   o.eyes[1] = false;
-  FrameResult frame = renderFrame(backend, rig, o);
+  FrameResult frame = renderer.render(rig, o);
   EyeCamera camera = rig.eye(Eye::Left);
   double ghostClamped = 0, ghostUnclamped = 0;
   for (bool clamp : {true, false}) {
     TaaHistory history;
     TaaParams params;
     params.clampToNeighbourhood = clamp;
-    EyeResult eye = frame.eyes[0];
-    resolveTemporal(camera, params, eye, history);
-    EyeResult brighter = frame.eyes[0];
-    for (Vec3& c : brighter.image.pixels) c *= 4.0f;
-    const Image expected = brighter.image;
-    EXPECT_EQ(resolveTemporal(camera, params, brighter, history), size_t(rig.width) * rig.height);
+    const EyeResult& eye = frame.eyes[0];
+    Image shown;
+    resolveTemporal(camera, params, eye.image, eye.inverseDepth, nullptr, history, shown);
+    Image expected = eye.image;
+    for (Vec3& c : expected.pixels) c *= 4.0f;
+    EXPECT_EQ(resolveTemporal(camera, params, expected, eye.inverseDepth, nullptr, history, shown),
+              size_t(rig.width) * rig.height);
     // The ghost: the share of the change still missing, averaged over the lit pixels.
     double ghost = 0;
     size_t lit = 0;
     for (size_t i = 0; i < expected.pixels.size(); ++i) {
       double change = 0.75 * luminance(expected.pixels[i]);
       if (change <= 0.0) continue;
-      ghost += luminance(abs(brighter.image.pixels[i] - expected.pixels[i])) / change;
+      ghost += luminance(abs(shown.pixels[i] - expected.pixels[i])) / change;
       ++lit;
     }
     ASSERT_GT(lit, expected.pixels.size() / 3);
@@ -221,7 +223,7 @@ TEST(Temporal, ClampingStopsGhosts) {
 TEST(Temporal, ResetAndNewEyeSizeStartFromTheRenderedFrame) {
   Scene scene = builtinScene("cornell");
   StereoRig rig = smallRig(scene);
-  CpuFrameRenderer renderer(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
   RenderOptions o = smallOptions();
   RenderOptions other = o;
   other.gather.seed = 5;

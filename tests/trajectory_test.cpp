@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "pvr/frame/trajectory.h"
+#include "pvr/app/trajectory.h"
 #include "pvr/util/error.h"
 
 namespace pvr {

@@ -5,8 +5,7 @@
 // shared edge or vertex never slip between the triangles that share it. Barycentrics and
 // primitive ids follow Embree's convention, so both backends report the same hits.
 #include "pvr/accel/bvh.h"
-#include "pvr/camera/stereo_rig.h"
-#include "pvr/shading/scene_view.h"
+#include "pvr/geometry/ray.h"
 
 namespace pvr {
 

@@ -10,10 +10,11 @@
 #include <regex>
 
 #include "frame_bench.h"
+#include "pvr/app/options.h"
 #include "pvr/foveation/mask.h"
-#include "pvr/frame/trajectory.h"
+#include "pvr/app/trajectory.h"
 #include "map_bench.h"
-#include "pvr/render/image.h"
+#include "pvr/image/image_io.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
@@ -106,23 +107,21 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--photon-depth", a.photonDepth, "Maximum surface interactions per photon path")->capture_default_str();
 }
 
+// The render options from their spellings: syntax here, ranges in validateOptions (one place).
 RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   RenderOptions o;
   Size2 photons = parsePhotonGrid(a.photons);
-  if (photons.x <= 0 || photons.y <= 0) throw Error("--photons must be positive, got '" + a.photons + "'");
-  if (photons.x * photons.y > (1ll << 26)) throw Error("--photons is too large: at most 67108864 (8192x8192)");
+  if (photons.x > 0xffffffffll || photons.y > 0xffffffffll || photons.x * photons.y > 0xffffffffll)
+    throw Error("--photons: too many photons: '" + a.photons + "' (at most " + std::to_string(kMaxPhotons) + ", 8192x8192)");
   o.photonsX = uint32_t(photons.x);
   o.photonsY = uint32_t(photons.y);
   o.gather.density.radius = parseFloat(a.radius, "--radius");
-  if (!(o.gather.density.radius > 0.0f) || !std::isfinite(o.gather.density.radius))
-    throw Error("--radius must be a positive finite number, got '" + a.radius + "'");
   if (a.map == "hashgrid") o.map = PhotonMapKind::HashGrid;
   else if (a.map == "kdtree") o.map = PhotonMapKind::KdTree;
   else throw Error("--map must be hashgrid or kdtree, got '" + a.map + "'");
   if (a.estimator == "radius") o.gather.density.estimator = Estimator::Radius;
   else if (a.estimator == "knn") o.gather.density.estimator = Estimator::Knn;
   else throw Error("--estimator must be radius or knn, got '" + a.estimator + "'");
-  if (a.k < 1 || a.k > kMaxKnn) throw Error("--k must be between 1 and " + std::to_string(kMaxKnn));
   o.gather.density.k = a.k;
   if (a.kernel == "single") o.kernel = DensityKernel::Single;
   else if (a.kernel == "hybrid") o.kernel = DensityKernel::Hybrid;
@@ -136,11 +135,8 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   else throw Error("--eyes must be left, right or both, got '" + a.eyes + "'");
   if (!a.eyeSize.empty()) setEyeSize(rig, a.eyeSize);
   if (!a.ipd.empty()) {
-    float ipd = parseFloat(a.ipd, "--ipd");
-    if (!(ipd >= 0.0f && ipd <= 1.0f)) throw Error("--ipd must be between 0 and 1 metre, got '" + a.ipd + "'");
-    rig.ipd = ipd;
+    rig.ipd = parseFloat(a.ipd, "--ipd");
   }
-  if (a.spp < 1 || a.spp > 4096) throw Error("--spp must be between 1 and 4096");
   o.gather.samplesPerPixel = a.spp;
   o.gather.seed = a.seed;
   o.maxPhotonDepth = a.photonDepth;
@@ -149,7 +145,6 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   else if (a.shading == "photons") o.gather.mode = ShadingMode::PhotonMapOnly;
   else throw Error("--shading must be full or photons, got '" + a.shading + "'");
   if (!(a.exposure > 0.0f) || !std::isfinite(a.exposure)) throw Error("--exposure must be a positive number");
-  validateOptions(o, rig);
   return o;
 }
 
@@ -162,15 +157,13 @@ int runRender(const RenderArgs& a) {
   if (a.foveated) {
     float gx = 0, gy = 0;
     char extra = 0;
-    if (std::sscanf(a.gaze.c_str(), "%f,%f%c", &gx, &gy, &extra) != 2 || !(gx >= 0.0f && gx <= 1.0f) ||
-        !(gy >= 0.0f && gy <= 1.0f))
-      throw Error("--gaze must be X,Y with both in [0, 1] (image fractions, 0.5,0.5 = centre), got '" + a.gaze + "'");
-    mask = a.mask.empty() ? generateFoveationMask(maskParamsForRig(rig)) : loadFoveationMask(a.mask);
-    checkMaskFits(mask, rig.width, rig.height);
-    options.foveation.mask = &mask;
+    if (std::sscanf(a.gaze.c_str(), "%f,%f%c", &gx, &gy, &extra) != 2)
+      throw Error("--gaze must be X,Y (image fractions, 0.5,0.5 = centre), got '" + a.gaze + "'");
     options.foveation.gaze[0][0] = gx, options.foveation.gaze[0][1] = gy;
+    validateOptions(options, rig);  // before the mask is made: a bad gaze need not wait for it
+    mask = a.mask.empty() ? generateFoveationMask(maskParamsForRig(rig)) : loadFoveationMask(a.mask);
+    options.foveation.mask = &mask;
     options.foveation.verge = true;  // both eyes fixate what the left eye's gaze meets
-    validateOptions(options, rig);
   } else if (!a.mask.empty()) {
     throw Error("--mask is for --foveated rendering");
   }
@@ -178,9 +171,8 @@ int runRender(const RenderArgs& a) {
   if (a.taa) {
     options.temporal.enabled = true;
     if (!a.taaBlend.empty()) options.temporal.taa.blend = parseFloat(a.taaBlend, "--taa-blend");
-    if (!(options.temporal.taa.blend > 0.0f && options.temporal.taa.blend <= 1.0f))
-      throw Error("--taa-blend must be in (0, 1], got '" + a.taaBlend + "'");
   }
+  validateOptions(options, rig);  // all of them, before any work
   std::vector<TrajectoryFrame> trajectory;
   if (!a.trajectory.empty()) trajectory = loadTrajectory(a.trajectory);
   ensureParentDirectory(a.out);  // before the work, not after it
@@ -264,11 +256,11 @@ int runRender(const RenderArgs& a) {
       std::printf("wrote %s\n", path.c_str());
     }
   }
-  if (!frame.eyes[1].reusedFrom.empty()) {  // where the right eye took the left eye's shading (per pixel)
+  if (frame.eyes[1].reusedFrom) {  // where the right eye took the left eye's shading (per pixel)
     const EyeResult& right = frame.eyes[1];
     Image mask(right.image.width, right.image.height);
     for (size_t i = 0; i < mask.pixels.size(); ++i)
-      mask.pixels[i] = right.reusedFrom[i] != kNotReused ? Vec3(1.0f) : (right.inverseDepth[i] > 0.0f ? Vec3(0.15f, 0, 0) : Vec3(0.0f));
+      mask.pixels[i] = (*right.reusedFrom)[i] != kNotReused ? Vec3(1.0f) : (right.inverseDepth[i] > 0.0f ? Vec3(0.15f, 0, 0) : Vec3(0.0f));
     std::string path = a.out + "_right_reused.png";
     writeImage(mask, path, 1.0f);
     std::printf("wrote %s (white: reused from the left eye; red: shaded by the right eye; black: background)\n", path.c_str());
@@ -419,6 +411,9 @@ int runCli(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::cerr << "photonvr: error: " << e.what() << " (see photonvr --help)\n";
     return 2;
+  } catch (const OptionError& e) {
+    std::cerr << "photonvr: error: " << describeForCli(e) << "\n";
+    return 1;
   } catch (const Error& e) {
     std::cerr << "photonvr: error: " << e.what() << "\n";
     return 1;

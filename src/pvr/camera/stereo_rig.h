@@ -2,6 +2,7 @@
 // Per-eye pinhole cameras of a headset: head pose, interpupillary distance, asymmetric field of
 // view (OpenXR's XrFovf: four signed angles) and per-eye resolution. World-to-pixel and
 // pixel-to-ray are exact inverses; the main paper's equations 3-5 are the symmetric special case.
+#include "pvr/geometry/ray.h"
 #include "pvr/math/vec.h"
 
 namespace pvr {
@@ -19,11 +20,6 @@ struct Pose {
 // the optical axis, as in XrFovf.
 struct Fov {
   float angleLeft = -0.8f, angleRight = 0.8f, angleUp = 0.8f, angleDown = -0.8f;
-};
-
-struct Ray {
-  Vec3 origin;
-  Vec3 dir;
 };
 
 enum class Eye : int { Left = 0, Right = 1 };

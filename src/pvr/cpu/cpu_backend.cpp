@@ -1,10 +1,9 @@
 #include "pvr/cpu/cpu_backend.h"
 
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
+
+#include "pvr/util/parallel_for.h"
 
 namespace pvr {
 
@@ -17,8 +16,8 @@ std::vector<Photon> CpuBackend::tracePhotons(const PhotonTraceParams& params) co
   std::vector<int> counts(chunk);
   for (uint32_t first = 0; first < params.photonCount; first += chunk) {
     uint32_t n = std::min(chunk, params.photonCount - first);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 256), [&](const tbb::blocked_range<uint32_t>& r) {
-      for (uint32_t i = r.begin(); i < r.end(); ++i)
+    parallelFor("photon trace", n, 256, [&](size_t begin, size_t end) {
+      for (uint32_t i = uint32_t(begin); i < uint32_t(end); ++i)
         counts[i] = tracePhoton(view, intersector_, params, first + i, &scratch[size_t(i) * slots]);
     });
     for (uint32_t i = 0; i < n; ++i)
@@ -32,15 +31,13 @@ void CpuBackend::renderEyeWith(const EyeCamera& camera, Eye eye, const GatherPar
                                PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const {
   SceneView view = scene_.view();
   // 16x16 tiles: coherent rays per task and good load balance.
-  tbb::parallel_for(tbb::blocked_range2d<int>(0, camera.height, 16, 0, camera.width, 16),
-                    [&](const tbb::blocked_range2d<int>& r) {
-                      for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-                        for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                          size_t pixel = size_t(y) * camera.width + x;
-                          out[pixel] = shadePixel(view, intersector_, map, params, camera, eye, x, y, reuse,
-                                                  surfaces ? surfaces + pixel : nullptr);
-                        }
-                    });
+  parallelForTiles("eye pass", camera.height, camera.width, 16, [&](int y0, int y1, int x0, int x1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        size_t pixel = size_t(y) * camera.width + x;
+        out[pixel] = shadePixel(view, intersector_, map, params, camera, eye, x, y, reuse, surfaces ? surfaces + pixel : nullptr);
+      }
+  });
 }
 
 void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
@@ -54,20 +51,21 @@ void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams&
 }
 
 template <class Map>
-size_t CpuBackend::renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                                         const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
-                                         const StereoReuseView& reuse, SurfaceRecord* surfaces, size_t* reused) const {
+size_t CpuBackend::shadeMaskVerticesWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                                         const FoveationMask& mask, int gazeX, int gazeY, std::vector<Vec3>& colours,
+                                         std::vector<float>& inverseDepths, const StereoReuseView& reuse,
+                                         SurfaceRecord* surfaces, size_t* reused) const {
   SceneView view = scene_.view();
   std::vector<uint8_t> used = verticesInUse(mask, gazeX, gazeY);
   std::vector<uint32_t> vertices;
   for (uint32_t i = 0; i < used.size(); ++i)
     if (used[i]) vertices.push_back(i);
-  std::vector<Vec3> colours(mask.offsets.size());
-  std::vector<float> inverseDepths(mask.offsets.size(), 0.0f);
+  colours.resize(mask.offsets.size());
+  inverseDepths.assign(mask.offsets.size(), 0.0f);
   std::atomic<size_t> reusedVertices{0};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+  parallelFor("foveated vertices", vertices.size(), 256, [&](size_t begin, size_t end) {
     size_t reusedHere = 0;
-    for (size_t k = r.begin(); k < r.end(); ++k) {
+    for (size_t k = begin; k < end; ++k) {
       const uint32_t v = vertices[k];
       const MaskPoint& o = mask.offsets[v];
       PixelSample sample;
@@ -79,31 +77,32 @@ size_t CpuBackend::renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const
     }
     reusedVertices += reusedHere;
   });
-  reconstructFoveatedEye(mask, gazeX, gazeY, colours, inverseDepths, out);
-  out.firstPrim.clear();
   if (reused) *reused = reusedVertices;
   return vertices.size();
 }
 
-size_t CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params,
+size_t CpuBackend::shadeMaskVertices(const EyeCamera& camera, Eye eye, const GatherParams& params,
                                      const HashGridView& map, const FoveationMask& mask, int gazeX, int gazeY,
-                                     EyeResult& out, const StereoReuseView& reuse, SurfaceRecord* surfaces,
-                                     size_t* reused) const {
-  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out, reuse, surfaces, reused);
+                                     std::vector<Vec3>& colours, std::vector<float>& inverseDepths,
+                                     const StereoReuseView& reuse, SurfaceRecord* surfaces, size_t* reused) const {
+  return shadeMaskVerticesWith(camera, eye, params, map, mask, gazeX, gazeY, colours, inverseDepths, reuse, surfaces,
+                               reused);
 }
 
-size_t CpuBackend::renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                                     const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
-                                     const StereoReuseView& reuse, SurfaceRecord* surfaces, size_t* reused) const {
-  return renderFoveatedEyeWith(camera, eye, params, map, mask, gazeX, gazeY, out, reuse, surfaces, reused);
+size_t CpuBackend::shadeMaskVertices(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                                     const FoveationMask& mask, int gazeX, int gazeY, std::vector<Vec3>& colours,
+                                     std::vector<float>& inverseDepths, const StereoReuseView& reuse,
+                                     SurfaceRecord* surfaces, size_t* reused) const {
+  return shadeMaskVerticesWith(camera, eye, params, map, mask, gazeX, gazeY, colours, inverseDepths, reuse, surfaces,
+                               reused);
 }
 
 void CpuBackend::scatter(const SurfaceRecord* source, size_t sourcePixels, const EyeCamera& target,
                            uint64_t* scattered) const {
   SceneView view = scene_.view();
   std::fill(scattered, scattered + size_t(target.width) * target.height, kNothingScattered);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, sourcePixels, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) {
+  parallelFor("stereo scatter", sourcePixels, 1024, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
       uint32_t pixel;
       uint64_t entry;
       if (!scatterTarget(view, intersector_, source[i], uint32_t(i), target, pixel, entry)) continue;

@@ -1,6 +1,7 @@
 #pragma once
-// The CPU reference backend: the shared photon-tracing and gathering code over Embree, with TBB
-// parallel loops. Every result is independent of thread count and scheduling.
+// The CPU reference backend's work: the shared photon-tracing and gathering code over Embree, in
+// labelled parallel loops (TBB). Every result is independent of thread count and scheduling.
+// CpuFrameBackend (cpu_frame_backend.h) runs these as the frame pipeline's stages.
 #include <vector>
 
 #include "pvr/cpu/embree_intersector.h"
@@ -29,18 +30,18 @@ class CpuBackend {
                  PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
                  SurfaceRecord* surfaces = nullptr) const;
 
-  // Foveated: shades the mask's vertices in use for the gaze pixel (gazeX, gazeY) and reconstructs
-  // the eye's image, depth and sample spacing from them into `out`; returns the vertices shaded.
-  // Vertices on pixel centres take the other eye's shading where `reuse` allows (counted in
-  // `reused`) and record their surfaces in `surfaces` (per pixel) if given.
-  size_t renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
-                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
-                           const StereoReuseView& reuse = StereoReuseView(), SurfaceRecord* surfaces = nullptr,
-                           size_t* reused = nullptr) const;
-  size_t renderFoveatedEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                           const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
-                           const StereoReuseView& reuse = StereoReuseView(), SurfaceRecord* surfaces = nullptr,
-                           size_t* reused = nullptr) const;
+  // Foveated: shades the mask's vertices in use for the gaze pixel (gazeX, gazeY) into
+  // `colours` and `inverseDepths` (one per mask vertex; unused ones untouched); returns the
+  // vertices shaded. Vertices on pixel centres take the other eye's shading where `reuse` allows
+  // (counted in `reused`) and record their surfaces in `surfaces` (per pixel) if given.
+  size_t shadeMaskVertices(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
+                           const FoveationMask& mask, int gazeX, int gazeY, std::vector<Vec3>& colours,
+                           std::vector<float>& inverseDepths, const StereoReuseView& reuse = StereoReuseView(),
+                           SurfaceRecord* surfaces = nullptr, size_t* reused = nullptr) const;
+  size_t shadeMaskVertices(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                           const FoveationMask& mask, int gazeX, int gazeY, std::vector<Vec3>& colours,
+                           std::vector<float>& inverseDepths, const StereoReuseView& reuse = StereoReuseView(),
+                           SurfaceRecord* surfaces = nullptr, size_t* reused = nullptr) const;
 
   // Scatter: projects every reusable source pixel's surface into `target`'s image, keeping the
   // nearest per target pixel in `scattered` (width * height entries, filled with kNothingScattered
@@ -52,9 +53,10 @@ class CpuBackend {
 
  private:
   template <class Map>
-  size_t renderFoveatedEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                               const FoveationMask& mask, int gazeX, int gazeY, EyeResult& out,
-                               const StereoReuseView& reuse, SurfaceRecord* surfaces, size_t* reused) const;
+  size_t shadeMaskVerticesWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                               const FoveationMask& mask, int gazeX, int gazeY, std::vector<Vec3>& colours,
+                               std::vector<float>& inverseDepths, const StereoReuseView& reuse,
+                               SurfaceRecord* surfaces, size_t* reused) const;
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
                      PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const;

@@ -37,6 +37,12 @@ void throwCudaError(cudaError_t error, const char* what, const char* file, int l
   throw Error(std::string("CUDA error: ") + cudaGetErrorString(error) + " (" + what + " at " + where + ")");
 }
 
+void throwLaunchError(cudaError_t error, const char* label) {
+  cudaGetLastError();  // a launch error is not sticky
+  if (error == cudaErrorMemoryAllocation) throw Error(std::string("GPU out of memory launching the ") + label + " kernel");
+  throw Error(std::string("CUDA error: ") + cudaGetErrorString(error) + " (launching the " + label + " kernel)");
+}
+
 size_t deviceBytesInUse() { return gBytesInUse.load(); }
 
 void* deviceAllocate(size_t bytes, const char* what) {

@@ -1,8 +1,10 @@
 #pragma once
 // CUDA plumbing for the backend: error checks that throw pvr::Error (one clear line for the
-// user, GPU out-of-memory included), device buffers that count the memory they hold, and event
-// timing of stages.
+// user, GPU out-of-memory included), labelled kernel launches (the label names the kernel in
+// errors and, as an NVTX range, in nsys/ncu), device buffers that count the memory they hold, and
+// event timing of stages.
 #include <cuda_runtime.h>
+#include <nvtx3/nvToolsExt.h>
 
 #include <atomic>
 #include <cstddef>
@@ -21,8 +23,33 @@ namespace pvr::cuda {
     if (pvrCudaStatus_ != cudaSuccess) ::pvr::cuda::throwCudaError(pvrCudaStatus_, #call, __FILE__, __LINE__); \
   } while (0)
 
-// After a kernel launch: launch errors (bad configuration) surface here, faults at the next sync.
-#define PVR_CUDA_CHECK_LAUNCH(name) PVR_CUDA_CHECK(cudaPeekAtLastError())
+// After a kernel launch: launch errors (bad configuration) surface here, naming the kernel;
+// faults surface at the next sync.
+[[noreturn]] void throwLaunchError(cudaError_t error, const char* label);
+inline void checkLaunch(const char* label) {
+  cudaError_t status = cudaPeekAtLastError();
+  if (status != cudaSuccess) throwLaunchError(status, label);
+}
+
+// An NVTX range for the scope's life: profilers show the work under its label.
+class NvtxRange {
+ public:
+  explicit NvtxRange(const char* label) { nvtxRangePushA(label); }
+  ~NvtxRange() { nvtxRangePop(); }
+  NvtxRange(const NvtxRange&) = delete;
+  NvtxRange& operator=(const NvtxRange&) = delete;
+};
+
+#ifdef __CUDACC__
+// Every kernel of the backend is launched through this: `label` says what it does ("eye rays").
+template <class... Params, class... Args>
+void launch(const char* label, void (*kernel)(Params...), dim3 grid, dim3 block, size_t sharedBytes,
+            cudaStream_t stream, Args&&... args) {
+  NvtxRange range(label);
+  kernel<<<grid, block, sharedBytes, stream>>>(std::forward<Args>(args)...);
+  checkLaunch(label);
+}
+#endif
 
 // Bytes held by every DeviceBuffer, and the optional limit (PVR_GPU_MEMORY_LIMIT_MB) that makes
 // allocations past it fail as if the GPU were out of memory.
@@ -91,6 +118,8 @@ class EventTimer {
   EventTimer& operator=(const EventTimer&) = delete;
   void start(cudaStream_t s) { PVR_CUDA_CHECK(cudaEventRecord(start_, s)); }
   void stop(cudaStream_t s) { PVR_CUDA_CHECK(cudaEventRecord(stop_, s)); }
+  // For scope ends (destructors): a failure here shows at the next checked call.
+  void stopNoThrow(cudaStream_t s) noexcept { (void)cudaEventRecord(stop_, s); }
   // Waits for the stop event.
   double ms() const {
     PVR_CUDA_CHECK(cudaEventSynchronize(stop_));

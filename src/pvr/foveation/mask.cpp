@@ -6,8 +6,6 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +13,7 @@
 #include <fstream>
 
 #include "pvr/util/error.h"
+#include "pvr/util/parallel_for.h"
 
 namespace pvr {
 namespace {
@@ -195,8 +194,8 @@ namespace {
 
 void rasterizeMask(const FoveationMask& mask, int gazeX, int gazeY, const VertexValues& in, const RasterTarget& out) {
   // Each pixel centre belongs to one triangle: triangles write disjoint pixels, in parallel.
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, mask.triangleCount(), 512), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t t = r.begin(); t < r.end(); ++t)
+  parallelFor("foveated reconstruction", mask.triangleCount(), 512, [&](size_t begin, size_t end) {
+    for (size_t t = begin; t < end; ++t)
       rasterizeTriangle(mask.offsets.data(), mask.triangles.data(), t, gazeX, gazeY, in, out);
   });
 }
@@ -211,7 +210,7 @@ Image reconstructFoveatedImage(const FoveationMask& mask, int gazeX, int gazeY, 
 }
 
 void reconstructFoveatedEye(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours,
-                            const std::vector<float>& vertexInverseDepths, EyeResult& eye) {
+                            const std::vector<float>& vertexInverseDepths, FoveatedImage& eye) {
   if (vertexColours.size() != mask.offsets.size() || vertexInverseDepths.size() != mask.offsets.size())
     throw Error("reconstruction needs one colour and one depth per mask vertex");
   const int w = mask.params.width, h = mask.params.height;

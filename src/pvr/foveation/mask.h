@@ -10,8 +10,7 @@
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/foveation/acuity.h"
 #include "pvr/foveation/reconstruct.h"
-#include "pvr/frame/frame.h"
-#include "pvr/frame/image.h"
+#include "pvr/image/image.h"
 
 namespace pvr {
 
@@ -63,10 +62,14 @@ FoveationMask loadFoveationMask(const std::string& path);
 // centre of pixel (gazeX, gazeY). Pixels no triangle covers stay black (none, if the gaze is
 // inside the image).
 Image reconstructFoveatedImage(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours);
-// The same for an eye's frame: its image, per-pixel inverse depth (blended from the vertices'),
-// and sample spacing, in `eye` (what TAA reads).
+// A foveated eye's frame: its image, per-pixel inverse depth (blended from the vertices') and
+// the spacing of the samples each pixel was rebuilt from (what TAA reads).
+struct FoveatedImage {
+  Image image;
+  std::vector<float> inverseDepth, sampleSpacing;
+};
 void reconstructFoveatedEye(const FoveationMask& mask, int gazeX, int gazeY, const std::vector<Vec3>& vertexColours,
-                            const std::vector<float>& vertexInverseDepths, EyeResult& eye);
+                            const std::vector<float>& vertexInverseDepths, FoveatedImage& eye);
 
 // Throws pvr::Error unless the mask was made for this eye size.
 void checkMaskFits(const FoveationMask& mask, int width, int height);

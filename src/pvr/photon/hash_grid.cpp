@@ -1,6 +1,5 @@
 #include "pvr/photon/hash_grid.h"
 
-#include <tbb/parallel_for.h>
 
 #include <cfloat>
 #include <cmath>
@@ -8,6 +7,7 @@
 #include <string>
 
 #include "pvr/util/error.h"
+#include "pvr/util/parallel_for.h"
 
 namespace pvr {
 namespace {
@@ -58,10 +58,12 @@ HashGrid HashGrid::build(const std::vector<Photon>& input, float radius) {
   uint64_t cellCount = uint64_t(g.dims[0]) * g.dims[1] * g.dims[2];
 
   std::vector<uint32_t> keys(input.size());
-  tbb::parallel_for(size_t(0), input.size(), [&](size_t i) {
-    int64_t c = g.cellOf(input[i].position);
-    if (c < 0) throw Error("photon " + std::to_string(i) + " has a non-finite position");
-    keys[i] = uint32_t(c);
+  parallelFor("hash-grid cell keys", input.size(), 4096, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      int64_t c = g.cellOf(input[i].position);
+      if (c < 0) throw Error("photon " + std::to_string(i) + " has a non-finite position");
+      keys[i] = uint32_t(c);
+    }
   });
   // Stable counting sort by cell: same order as a stable radix sort of (key, index) pairs.
   grid.cellStart_.assign(cellCount + 1, 0);

@@ -1,8 +1,9 @@
 #include "pvr/render/renderer.h"
 
+#include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/util/error.h"
 #ifdef PVR_HAVE_CUDA
-#include "pvr/cuda/cuda_renderer.h"
+#include "pvr/cuda/cuda_frame_backend.h"
 #endif
 
 namespace pvr {
@@ -23,17 +24,21 @@ bool cudaBackendAvailable(std::string* why) {
 #endif
 }
 
-std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& scene) {
+std::unique_ptr<FrameBackend> makeFrameBackend(BackendKind kind, const Scene& scene) {
   std::string why;
-  if (kind == BackendKind::Cpu) return std::make_unique<CpuFrameRenderer>(scene);
+  if (kind == BackendKind::Cpu) return std::make_unique<CpuFrameBackend>(scene);
   bool cuda = cudaBackendAvailable(&why);
-  if (kind == BackendKind::Auto && !cuda) return std::make_unique<CpuFrameRenderer>(scene);
+  if (kind == BackendKind::Auto && !cuda) return std::make_unique<CpuFrameBackend>(scene);
   if (!cuda) throw Error("--backend cuda: " + why);
 #ifdef PVR_HAVE_CUDA
-  return std::make_unique<CudaFrameRenderer>(scene);
+  return std::make_unique<CudaFrameBackend>(scene);
 #else
   throw Error("--backend cuda: " + why);
 #endif
+}
+
+std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& scene) {
+  return std::make_unique<FrameRenderer>(makeFrameBackend(kind, scene));
 }
 
 }  // namespace pvr

@@ -1,12 +1,14 @@
 #pragma once
-// Choosing a backend: the CPU reference (Embree + TBB) or CUDA.
+// photonvr's renderers: the frame pipeline (pvr/pipeline) over the backend of your choice, the
+// CPU reference (Embree + TBB) or CUDA.
 #include <memory>
 #include <string>
 
-#include "pvr/cpu/cpu_renderer.h"
-#include "pvr/frame/frame.h"
+#include "pvr/pipeline/frame_renderer.h"
 
 namespace pvr {
+
+class Scene;
 
 enum class BackendKind : int { Cpu = 0, Cuda = 1, Auto = 2 };
 
@@ -16,8 +18,9 @@ BackendKind parseBackendKind(const std::string& text);
 // True if this build has the CUDA backend and a CUDA GPU is usable; otherwise `why` says why not.
 bool cudaBackendAvailable(std::string* why = nullptr);
 
-// The renderer for `kind` (Auto: CUDA if available, else CPU). Throws pvr::Error for Cuda when
-// no GPU can be used.
+// The backend for `kind` (Auto: CUDA if available, else CPU). Throws pvr::Error for Cuda when no
+// GPU can be used. The scene must outlive it.
+std::unique_ptr<FrameBackend> makeFrameBackend(BackendKind kind, const Scene& scene);
 std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& scene);
 
 }  // namespace pvr

@@ -2,18 +2,11 @@
 // A read-only, pointer-based view of the scene for algorithm code on host and device:
 // indexed triangles, optional per-vertex normals, per-triangle materials, and the emitting
 // triangles with a power-proportional CDF for light sampling and photon emission.
+#include "pvr/geometry/ray.h"
 #include "pvr/shading/material.h"
 #include "pvr/util/sampling.h"
 
 namespace pvr {
-
-// A ray hit as every intersector reports it: Embree's and our CUDA traversal's convention.
-struct Hit {
-  float t = INFINITY;
-  uint32_t primId = ~0u;
-  float u = 0, v = 0;  ///< barycentrics of vertices 1 and 2
-  PVR_HOST_DEVICE bool valid() const { return primId != ~0u; }
-};
 
 // Local geometry at a hit.
 struct SurfacePoint {

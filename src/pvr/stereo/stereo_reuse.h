@@ -27,6 +27,10 @@ namespace pvr {
 
 enum class StereoMode : int { Separate = 0, Scatter = 1, Gather = 2 };
 
+inline const char* stereoModeName(StereoMode m) {  ///< "separate" | "scatter" | "gather"
+  return m == StereoMode::Scatter ? "scatter" : m == StereoMode::Gather ? "gather" : "separate";
+}
+
 constexpr uint32_t kNotReused = ~0u;            ///< a pixel shaded by its own eye
 constexpr uint64_t kNothingScattered = ~0ull;  ///< scatter buffer entry no left point reached
 constexpr float kSameSurfaceCosine = 0.95f;     ///< normals closer than ~18 degrees agree

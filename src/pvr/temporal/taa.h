@@ -20,6 +20,13 @@ struct TaaParams {
   bool clampToNeighbourhood = true;
 };
 
+// The temporal stage's options: each eye's displayed image blends in the previous one,
+// reprojected by depth and the head's motion.
+struct TemporalOptions {
+  bool enabled = false;
+  TaaParams taa;
+};
+
 // One eye's frame and its history, as device or host pointers.
 struct TaaView {
   EyeCamera camera, previousCamera;

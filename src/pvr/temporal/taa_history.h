@@ -2,7 +2,7 @@
 // TAA on the host (the CPU backend's): one eye's history and the resolve over its pixels.
 #include <vector>
 
-#include "pvr/frame/frame.h"
+#include "pvr/image/image.h"
 #include "pvr/temporal/taa.h"
 
 namespace pvr {
@@ -15,9 +15,11 @@ struct TaaHistory {
   bool valid = false;
 };
 
-// Blends `eye`'s image (which needs its inverseDepth; sampleSpacing if foveated) with `history`
-// reprojected to `camera`, replaces eye.image with the result and makes it the new history.
-// Returns the number of pixels that took history. A history of another eye size is dropped.
-size_t resolveTemporal(const EyeCamera& camera, const TaaParams& params, EyeResult& eye, TaaHistory& history);
+// Blends `current` (with its per-pixel inverse depth, and sample spacing if foveated, else null)
+// with `history` reprojected to `camera` into `displayed`, which becomes the new history. Returns
+// the number of pixels that took history. A history of another eye size is dropped.
+size_t resolveTemporal(const EyeCamera& camera, const TaaParams& params, const Image& current,
+                       const std::vector<float>& inverseDepth, const float* sampleSpacing, TaaHistory& history,
+                       Image& displayed);
 
 }  // namespace pvr

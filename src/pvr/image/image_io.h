@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "pvr/frame/image.h"
+#include "pvr/image/image.h"
 
 namespace pvr {
 

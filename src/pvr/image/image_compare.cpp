@@ -1,9 +1,9 @@
-#include "pvr/render/image_compare.h"
+#include "pvr/image/image_compare.h"
 
 #include <cmath>
 #include <limits>
 
-#include "pvr/render/image.h"
+#include "pvr/image/image_io.h"
 #include "pvr/util/error.h"
 
 namespace pvr {

@@ -1,4 +1,4 @@
-#include "pvr/cuda/gpu_temporal.cuh"
+#include "pvr/cuda/temporal.cuh"
 
 namespace pvr::cuda {
 namespace {
@@ -36,8 +36,8 @@ void GpuTemporal::resolve(Eye eye, const EyeCamera& camera, const TaaParams& par
   view.params = params;
   PVR_CUDA_CHECK(cudaMemsetAsync(historyPixels_.data() + e, 0, sizeof(unsigned), stream));
   dim3 grid(unsigned((camera.width + kBlock - 1) / kBlock), unsigned((camera.height + kBlock - 1) / kBlock));
-  resolveKernel<<<grid, dim3(kBlock, kBlock), 0, stream>>>(view, colour_[e][to].data(), historyPixels_.data() + e);
-  PVR_CUDA_CHECK_LAUNCH("temporalResolve");
+  launch("temporal resolve", resolveKernel, grid, dim3(kBlock, kBlock), 0, stream, view, colour_[e][to].data(),
+         historyPixels_.data() + e);
   PVR_CUDA_CHECK(cudaMemcpyAsync(depth_[e].data(), inverseDepth, pixels * sizeof(float), cudaMemcpyDeviceToDevice, stream));
   latest_[e] = to;
   camera_[e] = camera;

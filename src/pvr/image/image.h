@@ -1,5 +1,5 @@
 #pragma once
-// A linear-RGB float image (render/image_io writes it to PNG and EXR).
+// A linear-RGB float image (image_io.h writes it to PNG and EXR).
 #include <vector>
 
 #include "pvr/math/vec.h"

@@ -1,4 +1,4 @@
-#include "pvr/render/image.h"
+#include "pvr/image/image_io.h"
 
 #include <ImfRgbaFile.h>
 #include <stb_image_write.h>

@@ -1,4 +1,4 @@
-#include "pvr/frame/trajectory.h"
+#include "pvr/app/trajectory.h"
 
 #include <cmath>
 #include <fstream>

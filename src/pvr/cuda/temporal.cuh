@@ -1,5 +1,5 @@
 #pragma once
-// TAA on the GPU: each eye's history (its last displayed image, depth and camera) and the resolve
+// The temporal stage on the GPU: each eye's history (its last displayed image, depth and camera) and the resolve
 // kernel over the shared per-pixel code (pvr/temporal/taa.h).
 #include "pvr/cuda/cuda_util.cuh"
 #include "pvr/temporal/taa.h"

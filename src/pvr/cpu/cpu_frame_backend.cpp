@@ -1,0 +1,128 @@
+#include "pvr/cpu/cpu_frame_backend.h"
+
+#include <tbb/info.h>
+
+#include <fstream>
+#include <string>
+
+namespace pvr {
+
+std::string CpuFrameBackend::deviceName() const {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line, model = "CPU";
+  while (std::getline(cpuinfo, line))
+    if (line.rfind("model name", 0) == 0) {
+      model = line.substr(line.find(':') + 2);
+      break;
+    }
+  return model + ", " + std::to_string(tbb::info::default_concurrency()) + " threads";
+}
+
+size_t CpuFrameBackend::tracePhotons(const PhotonTraceParams& params) {
+  photons_ = backend_.tracePhotons(params);
+  return photons_.size();
+}
+
+size_t CpuFrameBackend::buildPhotonMap(PhotonMapKind kind, float radius) {
+  mapKind_ = kind;
+  if (kind == PhotonMapKind::HashGrid) {
+    grid_ = HashGrid::build(photons_, radius);
+    return grid_.memoryBytes();
+  }
+  tree_ = KdTree::build(photons_);
+  return tree_.memoryBytes();
+}
+
+void CpuFrameBackend::scatter(const EyeCamera& /*source: the records hold world positions*/, const EyeCamera& target) {
+  scattered_.resize(size_t(target.width) * target.height);
+  backend_.scatter(sourceSurfaces_.data(), sourceSurfaces_.size(), target, scattered_.data());
+}
+
+template <class Map>
+void CpuFrameBackend::renderEyeWith(const EyePass& pass, const Map& map) {
+  const int e = int(pass.eye);
+  const EyeCamera& camera = pass.camera;
+  const size_t pixels = size_t(camera.width) * camera.height;
+  EyeBuffers& out = eyes_[e];
+  StereoReuseView reuse;
+  SurfaceRecord* surfaces = nullptr;
+  if (pass.role == StereoRole::Source) {
+    sourceSurfaces_.assign(pixels, SurfaceRecord());  // foveated: only the vertices' pixels are written
+    surfaces = sourceSurfaces_.data();
+  } else if (pass.role == StereoRole::Reuser) {
+    reuse.mode = pass.reuse;
+    reuse.source = pass.source;
+    reuse.sourceSurfaces = sourceSurfaces_.data();
+    reuse.sourceImage = eyes_[int(Eye::Left)].rendered.pixels.data();
+    if (pass.reuse == StereoMode::Scatter) reuse.scattered = scattered_.data();
+  }
+
+  if (pass.foveated()) {
+    std::vector<Vec3> colours;
+    std::vector<float> inverseDepths;
+    size_t reused = 0;
+    {
+      StageScope scope(clock_, Stage::EyeRays, e);  // eye rays and estimates in one pass
+      counters_.shadedSamples[e] = backend_.shadeMaskVertices(camera, pass.eye, pass.gather, map, *pass.mask, pass.gazeX,
+                                                              pass.gazeY, colours, inverseDepths, reuse, surfaces, &reused);
+    }
+    StageScope scope(clock_, Stage::Reconstruct, e);
+    FoveatedImage image;
+    reconstructFoveatedEye(*pass.mask, pass.gazeX, pass.gazeY, colours, inverseDepths, image);
+    out.rendered = std::move(image.image);
+    out.inverseDepth = std::move(image.inverseDepth);
+    out.sampleSpacing = std::move(image.sampleSpacing);
+    if (pass.role == StereoRole::Reuser) counters_.reusedSamples += reused;
+    return;
+  }
+  samples_.assign(pixels, PixelSample());
+  {
+    StageScope scope(clock_, Stage::EyeRays, e);  // one fused pass, like the single kernel
+    backend_.renderEye(camera, pass.eye, pass.gather, map, samples_.data(), reuse, surfaces);
+  }
+  counters_.shadedSamples[e] = pixels;
+  out.rendered = Image(camera.width, camera.height);
+  out.firstPrim.resize(pixels);
+  out.inverseDepth.resize(pixels);
+  for (size_t i = 0; i < pixels; ++i) {
+    out.rendered.pixels[i] = samples_[i].radiance;
+    out.firstPrim[i] = samples_[i].firstPrim;
+    out.inverseDepth[i] = samples_[i].inverseDepth;
+  }
+  if (pass.role == StereoRole::Reuser) {
+    out.reusedFrom.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      out.reusedFrom[i] = samples_[i].reusedFrom;
+      counters_.reusedSamples += out.reusedFrom[i] != kNotReused ? 1 : 0;
+    }
+  }
+}
+
+void CpuFrameBackend::renderEye(const EyePass& pass) {
+  if (mapKind_ == PhotonMapKind::HashGrid) renderEyeWith(pass, grid_.view());
+  else renderEyeWith(pass, tree_.view());
+}
+
+void CpuFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) {
+  EyeBuffers& b = eyes_[int(eye)];
+  counters_.historyPixels[int(eye)] = pvr::resolveTemporal(camera, params, b.rendered, b.inverseDepth,
+                                                           foveated ? b.sampleSpacing.data() : nullptr,
+                                                           history_[int(eye)], b.displayed);
+}
+
+FrameCounters CpuFrameBackend::finishFrame() {
+  FrameCounters done = counters_;  // the CPU's stages finished as they returned
+  counters_ = FrameCounters();
+  return done;
+}
+
+void CpuFrameBackend::readEye(Eye eye, const EyeReadback& what, EyeResult& out) {
+  EyeBuffers& b = eyes_[int(eye)];  // the frame is over: its buffers move out
+  out.image = std::move(what.displayed ? b.displayed : b.rendered);
+  out.inverseDepth = std::move(b.inverseDepth);
+  if (what.firstPrim) out.firstPrim = std::move(b.firstPrim);
+  if (what.sampleSpacing) out.sampleSpacing = std::move(b.sampleSpacing);
+  if (what.reusedFrom) out.reusedFrom = std::move(b.reusedFrom);
+}
+
+}  // namespace pvr

@@ -1,0 +1,61 @@
+#pragma once
+// The frame pipeline's stages on the CPU reference backend: host buffers between the stages,
+// the work in CpuBackend's parallel loops, times on the host clock.
+#include <memory>
+#include <vector>
+
+#include "pvr/cpu/cpu_backend.h"
+#include "pvr/pipeline/frame_renderer.h"
+#include "pvr/temporal/taa_history.h"
+
+namespace pvr {
+
+class CpuFrameBackend : public FrameBackend {
+ public:
+  explicit CpuFrameBackend(const Scene& scene) : backend_(scene) {}
+  std::string name() const override { return "cpu"; }
+  std::string deviceName() const override;
+  StageClock& clock() override { return clock_; }
+
+  size_t tracePhotons(const PhotonTraceParams& params) override;
+  size_t buildPhotonMap(PhotonMapKind kind, float radius) override;
+  void scatter(const EyeCamera& source, const EyeCamera& target) override;
+  void renderEye(const EyePass& pass) override;
+  float inverseDepthAt(Eye eye, size_t pixel) override { return eyes_[int(eye)].inverseDepth.at(pixel); }
+  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) override;
+  void forgetHistory(Eye eye) override { history_[int(eye)].valid = false; }
+  FrameCounters finishFrame() override;
+  void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override;
+
+  const CpuBackend& backend() const { return backend_; }
+
+ private:
+  // One eye's buffers between its stages.
+  struct EyeBuffers {
+    Image rendered, displayed;
+    std::vector<float> inverseDepth, sampleSpacing;
+    std::vector<uint32_t> firstPrim, reusedFrom;
+  };
+  template <class Map>
+  void renderEyeWith(const EyePass& pass, const Map& map);
+
+  CpuBackend backend_;
+  HostStageClock clock_;
+  std::vector<Photon> photons_;
+  PhotonMapKind mapKind_ = PhotonMapKind::HashGrid;
+  HashGrid grid_;
+  KdTree tree_;
+  std::vector<SurfaceRecord> sourceSurfaces_;
+  std::vector<uint64_t> scattered_;
+  std::vector<PixelSample> samples_;
+  EyeBuffers eyes_[2];
+  TaaHistory history_[2];
+  FrameCounters counters_;
+};
+
+// A frame renderer on the CPU reference backend.
+inline FrameRenderer makeCpuFrameRenderer(const Scene& scene) {
+  return FrameRenderer(std::make_unique<CpuFrameBackend>(scene));
+}
+
+}  // namespace pvr

@@ -1,0 +1,248 @@
+#include "pvr/cuda/cuda_frame_backend.h"
+
+#include <algorithm>
+
+#include "pvr/cuda/cuda_stage_clock.h"
+#include "pvr/cuda/eye_pass.cuh"
+#include "pvr/cuda/photon_map_build.cuh"
+#include "pvr/cuda/photon_trace.cuh"
+#include "pvr/cuda/temporal.cuh"
+#include "pvr/foveation/mask.h"
+
+namespace pvr {
+
+bool cudaDeviceUsable(std::string* why) {
+  int count = 0;
+  cudaError_t status = cudaGetDeviceCount(&count);
+  if (status != cudaSuccess || count == 0) {
+    if (why)
+      *why = status == cudaSuccess ? std::string("no CUDA GPU is present")
+                                   : std::string("no usable CUDA GPU (") + cudaGetErrorString(status) + ")";
+    cudaGetLastError();
+    return false;
+  }
+  return true;
+}
+
+struct CudaFrameBackend::Impl {
+  const Scene& scene;
+  Bvh bvh;
+  cudaStream_t stream = nullptr;
+  cudaDeviceProp properties{};
+  cuda::DeviceScene deviceScene;
+  cuda::GpuPhotonTracer tracer;
+  cuda::GpuHashGrid grid;
+  cuda::GpuKdTree tree;
+  PhotonMapKind mapKind = PhotonMapKind::HashGrid;
+  HashGridView gridView;
+  KdTreeView treeView;
+  cuda::GpuEyePass eyePass;
+  cuda::GpuTemporal temporal;
+  std::unique_ptr<cuda::CudaStageClock> clock;
+  cuda::EventTimer benchTimer;
+  // What this frame did, for finishFrame() and readEye().
+  struct FrameState {
+    bool rendered[2] = {false, false}, foveated[2] = {false, false}, temporal = false, reused = false;
+    size_t pixels[2] = {0, 0};
+    int width[2] = {0, 0}, height[2] = {0, 0};
+  } frame;
+  // The foveation mask last used, uploaded once and keyed on its content id.
+  uint64_t maskId = 0;
+  uint32_t maskVertices = 0, maskTriangleCount = 0;
+  cuda::DeviceBuffer<MaskPoint> maskOffsets;
+  cuda::DeviceBuffer<uint32_t> maskTriangles, maskTrianglesBySize;
+  uint32_t smallTriangles = 0;
+
+  explicit Impl(const Scene& s) : scene(s), bvh(Bvh::build(s)) {
+    PVR_CUDA_CHECK(cudaGetDeviceProperties(&properties, 0));
+    PVR_CUDA_CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
+    clock = std::make_unique<cuda::CudaStageClock>(stream);
+    deviceScene.upload(scene, bvh);
+  }
+  ~Impl() { cudaStreamDestroy(stream); }
+
+  cuda::DeviceMap map() const {
+    cuda::DeviceMap m;
+    if (mapKind == PhotonMapKind::HashGrid) m.grid = &gridView;
+    else m.tree = &treeView;
+    return m;
+  }
+
+  cuda::DeviceMaskView uploadMask(const FoveationMask& mask) {
+    if (mask.id == 0 || mask.id != maskId) {
+      maskOffsets.upload(mask.offsets.data(), mask.offsets.size(), "foveation mask vertices", stream);
+      maskTriangles.upload(mask.triangles.data(), mask.triangles.size(), "foveation mask triangles", stream);
+      std::vector<uint32_t> small, large;
+      for (size_t t = 0; t < mask.triangleCount(); ++t) {  // sized at a central gaze: a load-balancing hint
+        int w, h;
+        triangleBoxSize(mask.offsets.data(), mask.triangles.data(), t, mask.params.width / 2, mask.params.height / 2, w, h);
+        (int64_t(w) * h <= cuda::kSmallTrianglePixels ? small : large).push_back(uint32_t(t));
+      }
+      smallTriangles = uint32_t(small.size());
+      small.insert(small.end(), large.begin(), large.end());
+      maskTrianglesBySize.upload(small.data(), small.size(), "foveation mask triangles by size", stream);
+      PVR_CUDA_CHECK(cudaStreamSynchronize(stream));  // the host lists go out of scope
+      maskId = mask.id;
+      maskVertices = uint32_t(mask.offsets.size());
+      maskTriangleCount = uint32_t(mask.triangleCount());
+    }
+    // Everything from the uploaded copy, nothing from the live mask.
+    cuda::DeviceMaskView view{maskOffsets.data(), maskTriangles.data(), maskVertices, maskTriangleCount};
+    view.smallTriangles = maskTrianglesBySize.data();
+    view.largeTriangles = maskTrianglesBySize.data() + smallTriangles;
+    view.smallCount = smallTriangles;
+    view.largeCount = maskTriangleCount - smallTriangles;
+    return view;
+  }
+};
+
+CudaFrameBackend::CudaFrameBackend(const Scene& scene) {
+  std::string why;
+  if (!cudaDeviceUsable(&why)) throw Error("the CUDA backend cannot run: " + why);
+  impl_ = std::make_unique<Impl>(scene);
+}
+
+CudaFrameBackend::~CudaFrameBackend() = default;
+
+std::string CudaFrameBackend::deviceName() const {
+  const cudaDeviceProp& p = impl_->properties;
+  return std::string(p.name) + " (sm_" + std::to_string(p.major) + std::to_string(p.minor) + ", " +
+         std::to_string(p.multiProcessorCount) + " SMs, " + std::to_string(p.totalGlobalMem >> 30) + " GiB)";
+}
+
+StageClock& CudaFrameBackend::clock() { return *impl_->clock; }
+const BvhBuildStats& CudaFrameBackend::bvhStats() const { return impl_->bvh.stats(); }
+size_t CudaFrameBackend::deviceBytes() const { return cuda::deviceBytesInUse(); }
+const cuda::DeviceScene& CudaFrameBackend::deviceScene() const { return impl_->deviceScene; }
+CUstream_st* CudaFrameBackend::stream() const { return impl_->stream; }
+
+size_t CudaFrameBackend::tracePhotons(const PhotonTraceParams& params) {
+  Impl& m = *impl_;
+  m.frame = Impl::FrameState();
+  return m.tracer.trace(m.deviceScene, params, m.stream);
+}
+
+size_t CudaFrameBackend::buildPhotonMap(PhotonMapKind kind, float radius) {
+  Impl& m = *impl_;
+  m.mapKind = kind;
+  if (kind == PhotonMapKind::HashGrid) {
+    m.grid.build(m.tracer.photons(), m.tracer.count(), m.tracer.bounds(), radius, m.stream);
+    m.gridView = m.grid.view();
+    return m.grid.memoryBytes();
+  }
+  m.tree.build(m.tracer.photons(), m.tracer.count(), m.stream);  // on the host: the stage's events span it
+  m.treeView = m.tree.view();
+  return m.tree.memoryBytes();
+}
+
+void CudaFrameBackend::scatter(const EyeCamera& /*source: the records hold world positions*/, const EyeCamera& target) {
+  impl_->eyePass.scatter(impl_->deviceScene, target, impl_->stream);
+}
+
+void CudaFrameBackend::renderEye(const EyePass& pass) {
+  Impl& m = *impl_;
+  const int e = int(pass.eye);
+  m.frame.rendered[e] = true;
+  m.frame.foveated[e] = pass.foveated();
+  m.frame.pixels[e] = size_t(pass.camera.width) * pass.camera.height;
+  m.frame.width[e] = pass.camera.width, m.frame.height[e] = pass.camera.height;
+  m.frame.reused = m.frame.reused || pass.role == StereoRole::Reuser;
+  if (pass.foveated())
+    m.eyePass.renderFoveated(m.deviceScene, m.map(), pass, m.uploadMask(*pass.mask), m.stream, *m.clock);
+  else
+    m.eyePass.render(m.deviceScene, m.map(), pass, m.stream, *m.clock);
+}
+
+float CudaFrameBackend::inverseDepthAt(Eye eye, size_t pixel) {
+  Impl& m = *impl_;
+  float value = 0;  // one value, waited for
+  PVR_CUDA_CHECK(cudaMemcpyAsync(&value, m.eyePass.inverseDepth(eye) + pixel, sizeof(float), cudaMemcpyDeviceToHost, m.stream));
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  return value;
+}
+
+void CudaFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) {
+  Impl& m = *impl_;
+  m.frame.temporal = true;
+  m.temporal.resolve(eye, camera, params, m.eyePass.image(eye), m.eyePass.inverseDepth(eye),
+                     foveated ? m.eyePass.sampleSpacing(eye) : nullptr, m.stream);
+}
+
+void CudaFrameBackend::forgetHistory(Eye eye) { impl_->temporal.forget(eye); }
+
+FrameCounters CudaFrameBackend::finishFrame() {
+  Impl& m = *impl_;
+  uint32_t shadedVertices[2] = {0, 0};
+  unsigned historyPixels[2] = {0, 0}, reused = 0;
+  if (m.frame.foveated[0] || m.frame.foveated[1]) m.eyePass.downloadShadedVertices(shadedVertices, m.stream);
+  if (m.frame.temporal) m.temporal.downloadHistoryPixels(historyPixels, m.stream);
+  if (m.frame.reused) m.eyePass.downloadReusedCount(&reused, m.stream);
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));  // also surfaces the frame's faults, if any
+  FrameCounters c;
+  for (int e = 0; e < 2; ++e) {
+    if (!m.frame.rendered[e]) continue;
+    c.shadedSamples[e] = m.frame.foveated[e] ? shadedVertices[e] : m.frame.pixels[e];
+    c.historyPixels[e] = historyPixels[e];
+  }
+  c.reusedSamples = reused;
+  c.deviceBytes = cuda::deviceBytesInUse();
+  return c;
+}
+
+void CudaFrameBackend::readEye(Eye eye, const EyeReadback& what, EyeResult& out) {
+  Impl& m = *impl_;
+  const size_t pixels = m.frame.pixels[int(eye)];
+  auto download = [&](auto* host, const auto* device, size_t n) {
+    PVR_CUDA_CHECK(cudaMemcpyAsync(host, device, n * sizeof(*host), cudaMemcpyDeviceToHost, m.stream));
+  };
+  out.image = Image(m.frame.width[int(eye)], m.frame.height[int(eye)]);
+  download(out.image.pixels.data(), what.displayed ? m.temporal.image(eye) : m.eyePass.image(eye), pixels);
+  out.inverseDepth.resize(pixels);
+  download(out.inverseDepth.data(), m.eyePass.inverseDepth(eye), pixels);
+  if (what.sampleSpacing) {
+    out.sampleSpacing.emplace(pixels);
+    download(out.sampleSpacing->data(), m.eyePass.sampleSpacing(eye), pixels);
+  }
+  if (what.firstPrim) {
+    out.firstPrim.emplace(pixels);
+    download(out.firstPrim->data(), m.eyePass.firstPrim(eye), pixels);
+  }
+  if (what.reusedFrom) {
+    out.reusedFrom.emplace(pixels);
+    download(out.reusedFrom->data(), m.eyePass.reusedFrom(), pixels);
+  }
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+}
+
+std::vector<Photon> CudaFrameBackend::tracePhotonsToHost(const PhotonTraceParams& params) {
+  Impl& m = *impl_;
+  uint32_t n = m.tracer.trace(m.deviceScene, params, m.stream);
+  std::vector<Photon> photons(n);
+  if (n)
+    PVR_CUDA_CHECK(cudaMemcpyAsync(photons.data(), m.tracer.photons(), n * sizeof(Photon), cudaMemcpyDeviceToHost, m.stream));
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  return photons;
+}
+
+double CudaFrameBackend::buildHashGrid(const std::vector<Photon>& photons, float radius, int repeats,
+                                       GpuHashGridCopy* copy) {
+  Impl& m = *impl_;
+  cuda::DeviceBuffer<Photon> input;
+  input.upload(photons.data(), photons.size(), "benchmark photons", m.stream);
+  Bounds3 bounds;  // what the tracer's kernel reduces on the device
+  for (const Photon& p : photons) bounds.extend(p.position);
+  std::vector<double> times;
+  for (int r = -1; r < std::max(repeats, 1); ++r) {
+    m.benchTimer.start(m.stream);
+    m.grid.build(input.data(), uint32_t(photons.size()), bounds, radius, m.stream);
+    m.benchTimer.stop(m.stream);
+    double ms = m.benchTimer.ms();
+    if (r >= 0) times.push_back(ms);
+  }
+  if (copy) m.grid.download(copy->photons, copy->cellStart, copy->sortedToInput);
+  m.gridView = m.grid.view();
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+
+}  // namespace pvr

@@ -1,0 +1,70 @@
+#pragma once
+// The frame pipeline's stages on the GPU: photon tracing, the hash-grid or kd-tree build, the
+// paper's single / hybrid / shared-memory eye passes and our cell-sorted one, foveated passes,
+// stereo scatter and TAA, with CUDA-event stage times. No CUDA header is needed to use it.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pvr/accel/bvh.h"
+#include "pvr/pipeline/frame_renderer.h"
+#include "pvr/photon/photon.h"
+
+struct CUstream_st;  // cudaStream_t
+
+namespace pvr {
+
+class Scene;
+namespace cuda {
+struct DeviceScene;
+}
+
+// True if a CUDA GPU can be used; otherwise `why` says why not in one line.
+bool cudaDeviceUsable(std::string* why);
+
+struct GpuHashGridCopy {
+  std::vector<Photon> photons;
+  std::vector<uint32_t> cellStart, sortedToInput;
+};
+
+class CudaFrameBackend : public FrameBackend {
+ public:
+  // Throws pvr::Error if no GPU can be used, or the scene does not fit on it.
+  explicit CudaFrameBackend(const Scene& scene);
+  ~CudaFrameBackend() override;
+  std::string name() const override { return "cuda"; }
+  std::string deviceName() const override;
+  StageClock& clock() override;
+
+  size_t tracePhotons(const PhotonTraceParams& params) override;
+  size_t buildPhotonMap(PhotonMapKind kind, float radius) override;
+  void scatter(const EyeCamera& source, const EyeCamera& target) override;
+  void renderEye(const EyePass& pass) override;
+  float inverseDepthAt(Eye eye, size_t pixel) override;
+  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) override;
+  void forgetHistory(Eye eye) override;
+  FrameCounters finishFrame() override;
+  void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override;
+
+  // Tools for tests and benchmarks.
+  std::vector<Photon> tracePhotonsToHost(const PhotonTraceParams& params);
+  // Builds the hash grid over `photons` on the GPU `repeats` times; returns the median build time
+  // in ms (CUDA events, cell keys to gathered photons; the photons' bounds are given, as the
+  // tracer reduces them while tracing) and optionally the grid.
+  double buildHashGrid(const std::vector<Photon>& photons, float radius, int repeats, GpuHashGridCopy* copy = nullptr);
+  const BvhBuildStats& bvhStats() const;
+  size_t deviceBytes() const;  ///< GPU memory held by this backend now
+  const cuda::DeviceScene& deviceScene() const;
+  CUstream_st* stream() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A frame renderer on the CUDA backend; throws pvr::Error if no GPU can be used.
+inline FrameRenderer makeCudaFrameRenderer(const Scene& scene) {
+  return FrameRenderer(std::make_unique<CudaFrameBackend>(scene));
+}
+
+}  // namespace pvr

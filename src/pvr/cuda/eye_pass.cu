@@ -1,0 +1,183 @@
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_select.cuh>
+#include <thrust/iterator/counting_iterator.h>
+
+#include "pvr/cuda/density.cuh"
+#include "pvr/cuda/eye_kernels.cuh"
+
+namespace pvr::cuda {
+namespace {
+
+// The paper's "single" scheme: eye ray and estimate in one kernel.
+template <class Map, Estimator E, StereoRole R>
+__global__ void singleKernel(SceneView scene, BvhIntersector intersector, Map map, GatherParams params,
+                             EyeCamera camera, Eye eye, StereoReuseView reuse, EyeOutputs out) {
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  params.density.estimator = E;  // compile-time estimator: the radius kernel carries no heap
+  size_t pixel = size_t(y) * camera.width + x;
+  PixelSample s = shadePixel(scene, intersector, map, params, camera, eye, x, y, reuseFor<R>(reuse),
+                             surfaceFor<R>(out, pixel));
+  out.image[pixel] = s.radiance;
+  recordPixel(out, pixel, s);
+}
+
+// Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
+template <StereoRole R>
+__global__ void eyeRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
+                              Eye eye, int sample, StereoReuseView reuse, GatherPoint* points, EyeOutputs out) {
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  size_t pixel = size_t(y) * camera.width + x;
+  PixelSample state;
+  if (R == StereoRole::Reuser && sample > 0) state.reusedFrom = out.reusedFrom[pixel];  // sample 0 decided
+  points[pixel] = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuseFor<R>(reuse), state,
+                                   surfaceFor<R>(out, pixel));
+  if (sample == 0) recordPixel(out, pixel, state);
+}
+
+
+template <Estimator E, class Map>
+void launchSingle(const DeviceScene& scene, const Map& map, const GatherParams& params, const EyeCamera& camera,
+                  Eye eye, StereoRole role, const StereoReuseView& reuse, const EyeOutputs& out, cudaStream_t stream) {
+  auto* kernel = role == StereoRole::Reuser   ? singleKernel<Map, E, StereoRole::Reuser>
+                 : role == StereoRole::Source ? singleKernel<Map, E, StereoRole::Source>
+                                              : singleKernel<Map, E, StereoRole::Alone>;
+  launch("eye rays + density (single kernel)", kernel, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0,
+         stream, scene.view, scene.intersector, map, params, camera, eye, reuse, out);
+}
+
+template <Estimator E>
+void dispatchSingle(const DeviceScene& scene, DeviceMap map, const GatherParams& params, const EyeCamera& camera,
+                    Eye eye, StereoRole role, const StereoReuseView& reuse, const EyeOutputs& out, cudaStream_t stream) {
+  if (map.grid) launchSingle<E>(scene, *map.grid, params, camera, eye, role, reuse, out, stream);
+  else launchSingle<E>(scene, *map.tree, params, camera, eye, role, reuse, out, stream);
+}
+
+}  // namespace
+
+StereoReuseView GpuEyePass::prepareReuse(const EyePass& pass, cudaStream_t stream, EyeOutputs& out) {
+  StereoReuseView reuse;
+  if (pass.role == StereoRole::Alone) return reuse;
+  const size_t pixels = size_t(pass.camera.width) * pass.camera.height;
+  if (pass.role == StereoRole::Source) {
+    surfaces_.reserve(pixels, "left-eye surfaces");
+    // Foveated, only the vertices' pixels are recorded: the rest must read as not reusable.
+    if (pass.foveated())
+      PVR_CUDA_CHECK(cudaMemsetAsync(surfaces_.data(), 0xff, pixels * sizeof(SurfaceRecord), stream));
+    out.surfaces = surfaces_.data();
+    return reuse;
+  }
+  reuse.mode = pass.reuse;
+  reuse.source = pass.source;
+  reuse.sourceSurfaces = surfaces_.data();
+  reuse.sourceImage = images_[int(Eye::Left)].data();
+  reuse.scattered = pass.reuse == StereoMode::Scatter ? scattered_.data() : nullptr;
+  reusedCount_.reserve(1, "reuse count");
+  PVR_CUDA_CHECK(cudaMemsetAsync(reusedCount_.data(), 0, sizeof(unsigned), stream));
+  out.reusedCount = reusedCount_.data();
+  if (!pass.foveated()) {  // foveated reuse is per vertex: no per-pixel sources
+    reusedFrom_.reserve(pixels, "reuse sources");
+    out.reusedFrom = reusedFrom_.data();
+  }
+  return reuse;
+}
+
+size_t GpuEyePass::memoryBytes() const {
+  size_t bytes = points_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
+                 reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
+                 vertexList_.bytes() + vertexCount_.bytes() + vertexPoints_.bytes() + vertexColours_.bytes() +
+                 vertexInverseDepths_.bytes();
+  for (int i = 0; i < 2; ++i)
+    bytes += images_[i].bytes() + firstPrim_[i].bytes() + inverseDepth_[i].bytes() + sampleSpacing_[i].bytes() +
+             sortKeys_[i].bytes() + sortValues_[i].bytes();
+  return bytes;
+}
+
+void GpuEyePass::downloadReusedCount(unsigned* host, cudaStream_t stream) const {
+  PVR_CUDA_CHECK(cudaMemcpyAsync(host, reusedCount_.data(), sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
+}
+
+void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& pass, cudaStream_t stream,
+                        StageClock& clock) {
+  const Eye eye = pass.eye;
+  const int e = int(eye);
+  const EyeCamera& camera = pass.camera;
+  const size_t pixels = size_t(camera.width) * camera.height;
+  const GatherParams& params = pass.gather;
+  const bool knn = params.density.estimator == Estimator::Knn;
+  Vec3* image = (images_[e].reserve(pixels, "eye image"), images_[e].data());
+  EyeOutputs out;
+  out.image = image;
+  out.firstPrim = (firstPrim_[e].reserve(pixels, "first-hit ids"), firstPrim_[e].data());
+  out.inverseDepth = (inverseDepth_[e].reserve(pixels, "eye depths"), inverseDepth_[e].data());
+  StereoReuseView reuse = prepareReuse(pass, stream, out);
+
+  if (pass.kernel == DensityKernel::Single) {  // shadePixel loops over the samples itself
+    StageScope scope(clock, Stage::EyeRays, e);
+    if (knn) dispatchSingle<Estimator::Knn>(scene, map, params, camera, eye, pass.role, reuse, out, stream);
+    else dispatchSingle<Estimator::Radius>(scene, map, params, camera, eye, pass.role, reuse, out, stream);
+    return;
+  }
+
+  points_.reserve(pixels, "gather points");
+  const bool sparse = pass.role == StereoRole::Reuser && map.grid && !knn;  // few points left to estimate
+  const bool sorted = pass.kernel == DensityKernel::CellSorted && !sparse;
+  uint32_t noCell = 0;
+  int endBit = 1;
+  if (sorted) {
+    for (int b = 0; b < 2; ++b) {
+      sortKeys_[b].reserve(pixels, "gather-point cell keys");
+      sortValues_[b].reserve(pixels, "gather-point order");
+    }
+    noCell = uint32_t(uint64_t(map.grid->dims[0]) * map.grid->dims[1] * map.grid->dims[2]);
+    endBit = radixBitsFor(uint64_t(noCell) + 1);
+    size_t bytes = 0;
+    cub::DoubleBuffer<uint32_t> k(sortKeys_[0].data(), sortKeys_[1].data()), v(sortValues_[0].data(), sortValues_[1].data());
+    PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, k, v, int(pixels), 0, endBit, stream));
+    temp_.reserve(bytes, "gather-point sort scratch");
+  }
+  if (sparse) {
+    estimateList_.reserve(pixels, "gather points to estimate");
+    estimateCount_.reserve(1, "gather points to estimate");
+    size_t bytes = 0;
+    PVR_CUDA_CHECK(cub::DeviceSelect::If(nullptr, bytes, thrust::counting_iterator<uint32_t>(0), estimateList_.data(),
+                                         estimateCount_.data(), int(pixels), NeedsEstimate{points_.data()}, stream));
+    temp_.reserve(bytes, "gather-point selection scratch");
+  }
+  auto* eyeRays = pass.role == StereoRole::Reuser   ? eyeRaysKernel<StereoRole::Reuser>
+                  : pass.role == StereoRole::Source ? eyeRaysKernel<StereoRole::Source>
+                                                    : eyeRaysKernel<StereoRole::Alone>;
+  const int samples = params.samplesPerPixel;
+  for (int s = 0; s < samples; ++s) {
+    {
+      StageScope scope(clock, Stage::EyeRays, e);
+      launch("eye rays", eyeRays, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream, scene.view,
+             scene.intersector, params, camera, eye, s, reuse, points_.data(), out);
+    }
+    StageScope scope(clock, Stage::Density, e);
+    if (sparse) {
+      size_t bytes = temp_.capacity();
+      PVR_CUDA_CHECK(cub::DeviceSelect::If(temp_.data(), bytes, thrust::counting_iterator<uint32_t>(0),
+                                           estimateList_.data(), estimateCount_.data(), int(pixels),
+                                           NeedsEstimate{points_.data()}, stream));
+      storeWithoutEstimate(points_.data(), uint32_t(pixels), s, samples, image, stream);
+      estimateWarpPerPoint(*map.grid, params.density.radius, points_.data(), estimateList_.data(), estimateCount_.data(),
+                           s, samples, image, stream);
+    } else if (pass.kernel == DensityKernel::Hybrid) {
+      estimateTiled(map, params.density, points_.data(), camera.width, camera.height, s, samples, image, stream);
+    } else if (pass.kernel == DensityKernel::SharedMemory) {
+      estimateSharedMemory(*map.grid, params.density, points_.data(), camera.width, camera.height, s, samples, image,
+                           stream);
+    } else {
+      writeCellKeysOfPoints(*map.grid, points_.data(), uint32_t(pixels), noCell, sortKeys_[0].data(),
+                            sortValues_[0].data(), stream);
+      cub::DoubleBuffer<uint32_t> k(sortKeys_[0].data(), sortKeys_[1].data()), v(sortValues_[0].data(), sortValues_[1].data());
+      size_t bytes = temp_.capacity();
+      PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, k, v, int(pixels), 0, endBit, stream));
+      estimateInOrder(*map.grid, params.density, points_.data(), v.Current(), uint32_t(pixels), s, samples, image, stream);
+    }
+  }
+}
+
+}  // namespace pvr::cuda

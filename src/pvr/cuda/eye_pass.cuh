@@ -1,0 +1,88 @@
+#pragma once
+// The eye pass on the GPU: the paper's single / hybrid / shared-memory schemes and our
+// cell-sorted one at full resolution (eye_pass.cu), foveated passes through a mask's vertices
+// (foveated_eye.cu), and stereo scatter (stereo_scatter.cu), over the shared gathering code.
+// Density estimation kernels are in density.cuh.
+#include "pvr/cuda/device_scene.cuh"
+#include "pvr/foveation/reconstruct.h"
+#include "pvr/pipeline/frame_backend.h"
+
+namespace pvr::cuda {
+
+// The photon map the eye pass reads: exactly one of the two is set.
+struct DeviceMap {
+  const HashGridView* grid = nullptr;
+  const KdTreeView* tree = nullptr;
+};
+
+// Per-pixel outputs of an eye pass besides its image (null pointers are not written).
+struct EyeOutputs {
+  Vec3* image = nullptr;
+  uint32_t* firstPrim = nullptr;
+  float* inverseDepth = nullptr;
+  SurfaceRecord* surfaces = nullptr;  ///< the left eye under stereo reuse
+  uint32_t* reusedFrom = nullptr;     ///< the right eye under stereo reuse
+  unsigned* reusedCount = nullptr;    ///< with reusedFrom: pixels that took the left eye's shading
+};
+
+// A foveation mask on the device, its triangles also listed by size for the raster: a thread
+// each for the small ones (the fovea's, a pixel or two), a warp each for the rest.
+struct DeviceMaskView {
+  const MaskPoint* offsets = nullptr;
+  const uint32_t* triangles = nullptr;  ///< 3 per triangle
+  uint32_t vertexCount = 0, triangleCount = 0;
+  const uint32_t* smallTriangles = nullptr;  ///< at most kSmallTrianglePixels candidate pixels
+  const uint32_t* largeTriangles = nullptr;
+  uint32_t smallCount = 0, largeCount = 0;
+};
+constexpr int kSmallTrianglePixels = 8;
+
+class GpuEyePass {
+ public:
+  // Shades one eye at full resolution into image(eye), firstPrim(eye) and inverseDepth(eye),
+  // timing its eye rays and density estimation on `clock`. Under stereo reuse the source (left)
+  // eye records its surfaces and the reuser (right), rendered after it (and after scatter() for
+  // Scatter), takes the left eye's shading where it may.
+  void render(const DeviceScene& scene, DeviceMap map, const EyePass& pass, cudaStream_t stream, StageClock& clock);
+  // Foveated: lists the mask's vertices in use for the eye's gaze, shades them (eye rays, then
+  // estimates) and rasterizes the eye's image, depth and sample spacing from them; firstPrim(eye)
+  // is not written.
+  void renderFoveated(const DeviceScene& scene, DeviceMap map, const EyePass& pass, const DeviceMaskView& mask,
+                      cudaStream_t stream, StageClock& clock);
+  // The number of vertices the last foveated pass of each eye shaded, copied when the stream gets there.
+  void downloadShadedVertices(uint32_t host[2], cudaStream_t stream) const;
+  // Scatter: projects the left eye's recorded surfaces into the target (right) image.
+  void scatter(const DeviceScene& scene, const EyeCamera& target, cudaStream_t stream);
+  const Vec3* image(Eye e) const { return images_[int(e)].data(); }
+  const uint32_t* firstPrim(Eye e) const { return firstPrim_[int(e)].data(); }
+  const float* inverseDepth(Eye e) const { return inverseDepth_[int(e)].data(); }
+  const float* sampleSpacing(Eye e) const { return sampleSpacing_[int(e)].data(); }  ///< foveated only
+  const uint32_t* reusedFrom() const { return reusedFrom_.data(); }
+  // The right eye's reused-sample count, copied to the host when the stream reaches it.
+  void downloadReusedCount(unsigned* host, cudaStream_t stream) const;
+  size_t memoryBytes() const;
+
+ private:
+  // Sets up the pass's part in stereo reuse: the left eye's surface records in `out`, or the
+  // right eye's view of them, with its reuse outputs in `out`.
+  StereoReuseView prepareReuse(const EyePass& pass, cudaStream_t stream, EyeOutputs& out);
+
+  DeviceBuffer<Vec3> images_[2];
+  DeviceBuffer<uint32_t> firstPrim_[2];
+  DeviceBuffer<float> inverseDepth_[2], sampleSpacing_[2];
+  DeviceBuffer<SurfaceRecord> surfaces_;
+  DeviceBuffer<uint64_t> scattered_;
+  DeviceBuffer<uint32_t> reusedFrom_;
+  DeviceBuffer<unsigned> reusedCount_;
+  DeviceBuffer<uint32_t> estimateList_, estimateCount_;  ///< the right eye's points still to estimate
+  DeviceBuffer<uint8_t> vertexUsed_;
+  DeviceBuffer<uint32_t> vertexList_, vertexCount_;  ///< foveated: the vertices shaded (count per eye)
+  DeviceBuffer<GatherPoint> vertexPoints_;
+  DeviceBuffer<Vec3> vertexColours_;
+  DeviceBuffer<float> vertexInverseDepths_;
+  DeviceBuffer<GatherPoint> points_;
+  DeviceBuffer<uint32_t> sortKeys_[2], sortValues_[2];
+  DeviceBuffer<unsigned char> temp_;
+};
+
+}  // namespace pvr::cuda

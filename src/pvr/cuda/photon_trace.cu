@@ -1,0 +1,111 @@
+#include <cub/device/device_scan.cuh>
+
+#include <algorithm>
+
+#include "pvr/cuda/photon_trace.cuh"
+
+namespace pvr::cuda {
+namespace {
+
+// Floats as ints whose order is the floats' order, for atomicMin/atomicMax on bounds.
+PVR_HOST_DEVICE inline int orderedFromFloat(float f) {
+  int i = int(floatBits(f));
+  return i >= 0 ? i : i ^ 0x7FFFFFFF;
+}
+PVR_HOST_DEVICE inline float floatFromOrdered(int i) {
+  return floatFromBits(uint32_t(i >= 0 ? i : i ^ 0x7FFFFFFF));
+}
+
+__global__ void tracePhotonsKernel(SceneView scene, BvhIntersector intersector, PhotonTraceParams params,
+                                   uint32_t first, uint32_t n, Photon* slots, uint32_t* counts, int* bounds) {
+  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  Bounds3 b;
+  if (i < n) {
+    Photon* out = slots + size_t(i) * params.maxDepth;
+    int stored = tracePhoton(scene, intersector, params, first + i, out);
+    counts[i] = uint32_t(stored);
+    for (int k = 0; k < stored; ++k) b.extend(out[k].position);
+  }
+  // Warp-reduce the bounds, then one lane updates the global bounds.
+  float v[6] = {b.lower.x, b.lower.y, b.lower.z, b.upper.x, b.upper.y, b.upper.z};
+  for (int offset = 16; offset > 0; offset >>= 1)
+    for (int a = 0; a < 6; ++a) {
+      float o = __shfl_xor_sync(0xffffffffu, v[a], offset);
+      v[a] = a < 3 ? fminf(v[a], o) : fmaxf(v[a], o);
+    }
+  if ((threadIdx.x & 31) == 0 && v[0] <= v[3]) {
+    for (int a = 0; a < 3; ++a) {
+      atomicMin(bounds + a, orderedFromFloat(v[a]));
+      atomicMax(bounds + 3 + a, orderedFromFloat(v[3 + a]));
+    }
+  }
+}
+
+__global__ void compactPhotonsKernel(const Photon* slots, const uint32_t* counts, const uint32_t* offsets, uint32_t n,
+                                     int slotsPerPhoton, Photon* out) {
+  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const Photon* src = slots + size_t(i) * slotsPerPhoton;
+  Photon* dst = out + offsets[i];
+  for (uint32_t k = 0; k < counts[i]; ++k) dst[k] = src[k];
+}
+
+}  // namespace
+
+GpuPhotonTracer::GpuPhotonTracer() { PVR_CUDA_CHECK(cudaMallocHost(&hostSummary_, 8 * sizeof(int))); }
+GpuPhotonTracer::~GpuPhotonTracer() { cudaFreeHost(hostSummary_); }
+
+size_t GpuPhotonTracer::memoryBytes() const {
+  return slots_.bytes() + photons_.bytes() + counts_.bytes() + offsets_.bytes() + summary_.bytes() + temp_.bytes();
+}
+
+uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParams& params, cudaStream_t stream) {
+  const int slotsPerPhoton = std::max(params.maxDepth, 1);
+  // Chunks bound the scratch slots to 256 MiB whatever the photon count and depth.
+  const uint32_t chunk =
+      uint32_t(std::clamp<uint64_t>((uint64_t(256) << 20) / (sizeof(Photon) * slotsPerPhoton), 1024, params.photonCount));
+  slots_.reserve(size_t(chunk) * slotsPerPhoton, "photon scratch slots");
+  counts_.reserve(size_t(chunk) + 1, "photon counts");
+  offsets_.reserve(size_t(chunk) + 1, "photon offsets");
+  summary_.reserve(8, "photon bounds");
+  size_t tempBytes = 0;
+  PVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, tempBytes, counts_.data(), offsets_.data(), chunk + 1, stream));
+  temp_.reserve(tempBytes, "photon scan scratch");
+
+  int init[6];
+  for (int a = 0; a < 3; ++a) init[a] = orderedFromFloat(INFINITY), init[3 + a] = orderedFromFloat(-INFINITY);
+  PVR_CUDA_CHECK(cudaMemcpyAsync(summary_.data(), init, sizeof init, cudaMemcpyHostToDevice, stream));
+  uint32_t stored = 0;
+  for (uint32_t first = 0; first < params.photonCount; first += chunk) {
+    uint32_t n = std::min(chunk, params.photonCount - first);
+    PVR_CUDA_CHECK(cudaMemsetAsync(counts_.data() + n, 0, sizeof(uint32_t), stream));
+    launch("photon trace", tracePhotonsKernel, blocksFor(n, 128), 128, 0, stream, scene.view, scene.intersector, params,
+           first, n, slots_.data(), counts_.data(), summary_.data());
+    size_t bytes = temp_.capacity();
+    PVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, counts_.data(), offsets_.data(), n + 1, stream));
+    PVR_CUDA_CHECK(cudaMemcpyAsync(hostSummary_, summary_.data(), 6 * sizeof(int), cudaMemcpyDeviceToHost, stream));
+    PVR_CUDA_CHECK(cudaMemcpyAsync(hostSummary_ + 6, offsets_.data() + n, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
+    PVR_CUDA_CHECK(cudaStreamSynchronize(stream));
+    uint32_t added = uint32_t(hostSummary_[6]);
+    if (size_t(stored) + added > photons_.capacity()) {  // grow, keeping earlier chunks
+      DeviceBuffer<Photon> bigger;
+      bigger.reserve(std::max<size_t>(size_t(stored + added) * 5 / 4, 1024), "stored photons");
+      if (stored)
+        PVR_CUDA_CHECK(cudaMemcpyAsync(bigger.data(), photons_.data(), stored * sizeof(Photon),
+                                       cudaMemcpyDeviceToDevice, stream));
+      photons_ = std::move(bigger);
+    }
+    launch("photon compaction", compactPhotonsKernel, blocksFor(n, 256), 256, 0, stream, slots_.data(), counts_.data(),
+           offsets_.data(), n, slotsPerPhoton, photons_.data() + stored);
+    stored += added;
+  }
+  count_ = stored;
+  bounds_ = Bounds3();
+  if (stored) {
+    bounds_.lower = {floatFromOrdered(hostSummary_[0]), floatFromOrdered(hostSummary_[1]), floatFromOrdered(hostSummary_[2])};
+    bounds_.upper = {floatFromOrdered(hostSummary_[3]), floatFromOrdered(hostSummary_[4]), floatFromOrdered(hostSummary_[5])};
+  }
+  return stored;
+}
+
+}  // namespace pvr::cuda

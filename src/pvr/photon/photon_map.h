@@ -1,0 +1,10 @@
+#pragma once
+// Which photon map a frame builds: the paper's hash grid (section 3.1) or the kd-tree it is
+// compared with.
+namespace pvr {
+
+enum class PhotonMapKind : int { HashGrid = 0, KdTree = 1 };
+
+inline const char* photonMapName(PhotonMapKind kind) { return kind == PhotonMapKind::HashGrid ? "hashgrid" : "kdtree"; }
+
+}  // namespace pvr

@@ -1,0 +1,135 @@
+#pragma once
+// The stages a backend implements (CPU: Embree + TBB; CUDA), and what each reads and writes.
+// The frame's order lives in one place, FrameRenderer (frame_renderer.h), which calls these;
+// a backend holds the frame's buffers (host or device memory) between the calls.
+//
+//   stage          reads                                        writes
+//   photon trace   scene                                        Photons
+//   map build      Photons                                      PhotonMap
+//   scatter        SourceSurfaces                               ScatteredSurfaces
+//   eye pass       PhotonMap; reuser: SourceSurfaces, the       RenderedImage, InverseDepth;
+//                  left RenderedImage, (scatter)                full: FirstHits; foveated:
+//                  ScatteredSurfaces                            SampleSpacing; source:
+//                                                               SourceSurfaces; full reuser:
+//                                                               ReusedFrom
+//   temporal       RenderedImage, InverseDepth, (foveated)      DisplayedImage (and the eye's
+//                  SampleSpacing, the eye's history             history)
+//
+// FrameDataflow checks these declarations while a frame runs: a stage that would read what no
+// earlier stage wrote this frame is an error, and a frame's results hold exactly what was written.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "pvr/pipeline/frame_options.h"
+#include "pvr/pipeline/frame_result.h"
+#include "pvr/pipeline/stage_clock.h"
+
+namespace pvr {
+
+// An eye's part in stereo reuse.
+enum class StereoRole : int {
+  Alone = 0,   ///< separate rendering
+  Source = 1,  ///< the left eye under reuse: records its surfaces for the right eye
+  Reuser = 2,  ///< the right eye under reuse: takes the left eye's shading where it may
+};
+
+// One eye pass: everything the backend needs to shade one eye, full or foveated.
+struct EyePass {
+  Eye eye = Eye::Left;
+  EyeCamera camera;
+  GatherParams gather;
+  PhotonMapKind map = PhotonMapKind::HashGrid;
+  DensityKernel kernel = DensityKernel::Hybrid;
+  StereoRole role = StereoRole::Alone;
+  StereoMode reuse = StereoMode::Separate;  ///< the reuser's: scatter or gather
+  EyeCamera source;                          ///< the reuser's: the eye it reuses (the left)
+  const FoveationMask* mask = nullptr;       ///< foveated: the mask, placed at the gaze pixel
+  int gazeX = 0, gazeY = 0;
+  bool foveated() const { return mask != nullptr; }
+};
+
+// Buffers that flow between stages. Photons, PhotonMap and the two surface buffers are the
+// frame's; the rest exist per eye.
+enum class FrameData : int {
+  Photons = 0,
+  PhotonMap,
+  SourceSurfaces,     ///< per left pixel: the surface the right eye may reuse
+  ScatteredSurfaces,  ///< per right pixel: the nearest left surface projected there
+  RenderedImage,      ///< the eye's image as shaded (what the reuser reads of the left eye)
+  InverseDepth,       ///< per pixel, 1 / view depth
+  FirstHits,          ///< per pixel, the first triangle hit (full resolution)
+  SampleSpacing,      ///< per pixel, the foveated samples' spacing
+  ReusedFrom,         ///< per right pixel, the left pixel it took its shading from
+  DisplayedImage,     ///< after TAA
+  Count,
+};
+const char* frameDataName(FrameData data);
+
+struct DataRef {
+  FrameData data;
+  int eye = kWholeFrame;
+};
+
+struct StageIO {
+  Stage stage;
+  std::vector<DataRef> reads, writes;
+};
+
+StageIO photonTraceIO();
+StageIO mapBuildIO();
+StageIO scatterIO();
+StageIO eyePassIO(const EyePass& pass);
+StageIO temporalIO(Eye eye, bool foveated);
+
+// What has been written this frame.
+class FrameDataflow {
+ public:
+  // Throws pvr::Error if the stage reads something not written yet; then marks its writes.
+  void run(const StageIO& io);
+  bool has(FrameData data, int eye = kWholeFrame) const { return written_[slot(data, eye)]; }
+
+ private:
+  static int slot(FrameData data, int eye) { return int(data) * 3 + eye + 1; }
+  bool written_[int(FrameData::Count) * 3] = {};
+};
+
+// Which of an eye's outputs to copy out at the end of the frame.
+struct EyeReadback {
+  bool displayed = false;  ///< the TAA image (else the rendered one)
+  bool firstPrim = false, sampleSpacing = false, reusedFrom = false;
+};
+
+struct FrameCounters {
+  size_t shadedSamples[2] = {0, 0};  ///< pixels, or mask vertices when foveated
+  size_t reusedSamples = 0;           ///< the reuser's samples that took the left eye's shading
+  size_t historyPixels[2] = {0, 0};   ///< TAA: pixels that blended in their history
+  size_t deviceBytes = 0;             ///< GPU memory held (0 on the CPU)
+};
+
+class FrameBackend {
+ public:
+  virtual ~FrameBackend() = default;
+  virtual std::string name() const = 0;  ///< "cpu" or "cuda"
+  virtual std::string deviceName() const = 0;
+  virtual StageClock& clock() = 0;
+
+  // Photon trace: returns the number of photons stored.
+  virtual size_t tracePhotons(const PhotonTraceParams& params) = 0;
+  // Map build over the stored photons: returns the map's bytes.
+  virtual size_t buildPhotonMap(PhotonMapKind kind, float radius) = 0;
+  // Scatter: the source eye's surfaces into the target eye's image.
+  virtual void scatter(const EyeCamera& source, const EyeCamera& target) = 0;
+  // The eye pass; times its own parts (EyeRays, Density, Reconstruct) on clock() for pass.eye.
+  virtual void renderEye(const EyePass& pass) = 0;
+  // One value of an eye's inverse depth (vergence needs the left eye's at its gaze); may wait.
+  virtual float inverseDepthAt(Eye eye, size_t pixel) = 0;
+  // Temporal: blends the eye's rendered image with its history into its displayed image.
+  virtual void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) = 0;
+  virtual void forgetHistory(Eye eye) = 0;  ///< the next resolve starts again
+  // Waits for the frame's work; the clock's times are valid after this.
+  virtual FrameCounters finishFrame() = 0;
+  virtual void readEye(Eye eye, const EyeReadback& what, EyeResult& out) = 0;
+};
+
+}  // namespace pvr

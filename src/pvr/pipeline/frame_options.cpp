@@ -1,0 +1,66 @@
+#include "pvr/pipeline/frame_options.h"
+
+#include <cmath>
+
+#include "pvr/foveation/mask.h"
+
+namespace pvr {
+
+const char* densityKernelName(DensityKernel k) {
+  switch (k) {
+    case DensityKernel::Single: return "single";
+    case DensityKernel::Hybrid: return "hybrid";
+    case DensityKernel::SharedMemory: return "shared";
+    case DensityKernel::CellSorted: return "sorted";
+  }
+  return "?";
+}
+
+void validateRig(const StereoRig& rig) {
+  if (rig.width < 1 || rig.height < 1 || rig.width > kMaxEyeDimension || rig.height > kMaxEyeDimension)
+    throw OptionError(RenderOption::EyeSize, "the eye size must be between 1x1 and " + std::to_string(kMaxEyeDimension) +
+                                                 "x" + std::to_string(kMaxEyeDimension) + ", got " +
+                                                 std::to_string(rig.width) + "x" + std::to_string(rig.height));
+  if (!(rig.ipd >= 0.0f) || !std::isfinite(rig.ipd))
+    throw OptionError(RenderOption::Ipd, "the IPD must be a non-negative finite number, got " + std::to_string(rig.ipd));
+}
+
+void validateOptions(const RenderOptions& o, const StereoRig& rig) {
+  validateRig(rig);
+  if (o.photonsX == 0 || o.photonsY == 0) throw OptionError(RenderOption::Photons, "the number of photons must be positive");
+  if (uint64_t(o.photonsX) * o.photonsY > kMaxPhotons)
+    throw OptionError(RenderOption::Photons, "too many photons: " + std::to_string(uint64_t(o.photonsX) * o.photonsY) +
+                                                 " (at most " + std::to_string(kMaxPhotons) + ", 8192x8192)");
+  if (o.maxPhotonDepth < 1 || o.maxPhotonDepth > kMaxPathDepth)
+    throw OptionError(RenderOption::PhotonDepth, "the photon depth must be between 1 and " + std::to_string(kMaxPathDepth));
+  const DensityParams& d = o.gather.density;
+  if (!(d.radius > 0.0f) || !std::isfinite(d.radius))
+    throw OptionError(RenderOption::Radius, "the search radius must be a positive finite number");
+  if (d.estimator == Estimator::Knn && (d.k < 1 || d.k > kMaxKnn))
+    throw OptionError(RenderOption::K, "k must be between 1 and " + std::to_string(kMaxKnn));
+  if (o.gather.samplesPerPixel < 1 || o.gather.samplesPerPixel > kMaxSamplesPerPixel)
+    throw OptionError(RenderOption::SamplesPerPixel,
+                      "samples per pixel must be between 1 and " + std::to_string(kMaxSamplesPerPixel));
+  if (o.gather.maxSpecularDepth < 0 || o.gather.maxSpecularDepth > kMaxPathDepth)
+    throw OptionError(RenderOption::SpecularDepth, "the specular depth must be between 0 and " + std::to_string(kMaxPathDepth));
+  if ((o.kernel == DensityKernel::SharedMemory || o.kernel == DensityKernel::CellSorted) &&
+      o.map != PhotonMapKind::HashGrid)
+    throw OptionError(RenderOption::Kernel,
+                      std::string("the ") + densityKernelName(o.kernel) + " kernel works on the hash grid, not the kd-tree");
+  for (int e = 0; e < 2; ++e)
+    for (float g : o.foveation.gaze[e])
+      if (!(g >= 0.0f && g <= 1.0f))
+        throw OptionError(RenderOption::Gaze, "the gaze must lie in the image: coordinates between 0 and 1");
+  if (o.foveation.mask) checkMaskFits(*o.foveation.mask, rig.width, rig.height);
+  if (o.temporal.enabled) {
+    const TaaParams& t = o.temporal.taa;
+    if (!(t.blend > 0.0f && t.blend <= 1.0f)) throw OptionError(RenderOption::TaaBlend, "the TAA blend must be in (0, 1]");
+    if (!(t.depthTolerance > 0.0f && t.depthTolerance < 1.0f))
+      throw OptionError(RenderOption::TaaDepthTolerance, "the TAA depth tolerance must be in (0, 1)");
+  }
+  if (o.stereo != StereoMode::Separate && !(o.eyes[0] && o.eyes[1]))
+    throw OptionError(RenderOption::Stereo, std::string("stereo reuse (") + stereoModeName(o.stereo) +
+                                                ") renders the right eye from the left: it needs both eyes");
+}
+
+}  // namespace pvr

@@ -1,0 +1,76 @@
+#pragma once
+// What a frame renders: each stage's options gathered in one struct, and the one place where
+// they are checked (validateOptions), in the library's own words.
+#include <string>
+
+#include "pvr/camera/stereo_rig.h"
+#include "pvr/foveation/foveation_options.h"
+#include "pvr/photon/gather.h"
+#include "pvr/photon/photon_map.h"
+#include "pvr/photon/photon_trace.h"
+#include "pvr/stereo/stereo_reuse.h"
+#include "pvr/temporal/taa.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+
+// How the GPU splits eye rays and density estimation (the main paper's section 3.2). Every scheme
+// computes the same image; the CPU backend computes it one way.
+enum class DensityKernel : int {
+  Single = 0,        ///< one kernel traces the eye ray and estimates (the paper's "OptiX-only")
+  Hybrid = 1,        ///< the eye-ray kernel writes gather points, a second kernel estimates
+  SharedMemory = 2,  ///< hybrid, estimation by the paper's Algorithm 1 (8x8 blocks stage photons)
+  CellSorted = 3,    ///< hybrid, gather points sorted by hash cell first, so each warp estimates one cell
+};
+
+const char* densityKernelName(DensityKernel k);  ///< "single" | "hybrid" | "shared" | "sorted"
+
+struct RenderOptions {
+  uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
+  int maxPhotonDepth = 8;
+  PhotonMapKind map = PhotonMapKind::HashGrid;
+  DensityKernel kernel = DensityKernel::Hybrid;
+  GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
+  bool eyes[2] = {true, true};
+  StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading
+  FoveationOptions foveation;
+  TemporalOptions temporal;
+  uint32_t photonCount() const { return photonsX * photonsY; }
+  // The photon pass these options ask for (every backend traces the same photons).
+  PhotonTraceParams photonTraceParams() const {
+    PhotonTraceParams p;
+    p.photonCount = photonCount();
+    p.seed = gather.seed;
+    p.maxDepth = maxPhotonDepth;
+    p.storeDirect = gather.mode == ShadingMode::PhotonMapOnly;  // the map alone then shades
+    return p;
+  }
+};
+
+constexpr int kMaxEyeDimension = 8192;
+constexpr uint64_t kMaxPhotons = uint64_t(1) << 26;  ///< 8192x8192
+constexpr int kMaxSamplesPerPixel = 4096;
+constexpr int kMaxPathDepth = 64;
+
+// The option an OptionError is about, so that a front end can name it its own way (the command
+// line names its flag).
+enum class RenderOption : int {
+  Photons, PhotonDepth, Radius, K, SamplesPerPixel, SpecularDepth, EyeSize, Ipd, Kernel, Gaze, TaaBlend,
+  TaaDepthTolerance, Stereo,
+};
+
+class OptionError : public Error {
+ public:
+  OptionError(RenderOption option, const std::string& message) : Error(message), option_(option) {}
+  RenderOption option() const { return option_; }
+
+ private:
+  RenderOption option_;
+};
+
+// Checks the rig a frame is rendered for (eye size, IPD); throws OptionError.
+void validateRig(const StereoRig& rig);
+// Checks options against the rig (and the rig); throws OptionError naming the bad value.
+void validateOptions(const RenderOptions& options, const StereoRig& rig);
+
+}  // namespace pvr
