@@ -214,6 +214,10 @@ void CudaFrameBackend::readEye(Eye eye, const EyeReadback& what, EyeResult& out)
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
 }
 
+const Vec3* CudaFrameBackend::deviceImage(Eye eye, bool displayed) const {
+  return displayed ? impl_->temporal.image(eye) : impl_->eyePass.image(eye);
+}
+
 std::vector<Photon> CudaFrameBackend::tracePhotonsToHost(const PhotonTraceParams& params) {
   Impl& m = *impl_;
   uint32_t n = m.tracer.trace(m.deviceScene, params, m.stream);

@@ -45,6 +45,7 @@ class CudaFrameBackend : public FrameBackend {
   void forgetHistory(Eye eye) override;
   FrameCounters finishFrame() override;
   void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override;
+  const Vec3* deviceImage(Eye eye, bool displayed) const override;
 
   // Tools for tests and benchmarks.
   std::vector<Photon> tracePhotonsToHost(const PhotonTraceParams& params);

@@ -130,6 +130,9 @@ class FrameBackend {
   // Waits for the frame's work; the clock's times are valid after this.
   virtual FrameCounters finishFrame() = 0;
   virtual void readEye(Eye eye, const EyeReadback& what, EyeResult& out) = 0;
+  // The eye's image (displayed: after TAA) where it lies in GPU memory: linear RGB, row-major,
+  // valid until the next frame; null for backends that render on the host.
+  virtual const Vec3* deviceImage(Eye eye, bool displayed) const { return nullptr; }
 };
 
 }  // namespace pvr

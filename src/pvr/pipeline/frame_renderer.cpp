@@ -77,8 +77,13 @@ void FrameRenderer::resetHistory() {
   for (Eye e : {Eye::Left, Eye::Right}) backend_->forgetHistory(e);
 }
 
+const Vec3* FrameRenderer::deviceImage(Eye eye) const {
+  return rendered_[int(eye)] ? backend_->deviceImage(eye, displayed_[int(eye)]) : nullptr;
+}
+
 FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
   validateOptions(options, rig);
+  rendered_[0] = rendered_[1] = false;
   FrameBackend& backend = *backend_;
   StageClock& clock = backend.clock();
   clock.newFrame();
@@ -146,6 +151,10 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& opt
   }
 
   const FrameCounters counters = backend.finishFrame();
+  for (int e = 0; e < 2; ++e) {
+    rendered_[e] = options.eyes[e];
+    displayed_[e] = flow.has(FrameData::DisplayedImage, e);
+  }
   frame.reusedPixels = counters.reusedSamples;
   frame.deviceBytes = counters.deviceBytes;
   StageTimings& t = frame.timings;

@@ -24,6 +24,9 @@ class FrameRenderer {
   FrameResult render(const StereoRig& rig, const RenderOptions& options, bool images = true);
   // Forgets the TAA history (a cut: the next frame is shown as rendered).
   void resetHistory();
+  // The last frame's displayed image of an eye in GPU memory (linear RGB, row-major, the rig's
+  // size), valid until the next frame; null on the CPU backend or for an eye not rendered.
+  const Vec3* deviceImage(Eye eye) const;
 
   std::string name() const { return backend_->name(); }  ///< "cpu" or "cuda"
   std::string deviceName() const { return backend_->deviceName(); }
@@ -37,6 +40,7 @@ class FrameRenderer {
 
  private:
   std::unique_ptr<FrameBackend> backend_;
+  bool rendered_[2] = {false, false}, displayed_[2] = {false, false};  ///< the last frame's
 };
 
 }  // namespace pvr

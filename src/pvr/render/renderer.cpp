@@ -41,4 +41,16 @@ std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& 
   return std::make_unique<FrameRenderer>(makeFrameBackend(kind, scene));
 }
 
+Renderer::Renderer(const Scene& scene, BackendKind backend) : rig_(scene.rig), frames_(makeFrameBackend(backend, scene)) {}
+
+FrameResult Renderer::renderFrame(const Pose& head, const float gaze[2], FrameOutput output) {
+  rig_.head = head;
+  RenderOptions o = options_;
+  if (gaze) {
+    o.foveation.gaze[0][0] = gaze[0], o.foveation.gaze[0][1] = gaze[1];
+    o.foveation.verge = true;
+  }
+  return frames_.render(rig_, o, output == FrameOutput::HostImages);
+}
+
 }  // namespace pvr

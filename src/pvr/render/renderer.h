@@ -23,4 +23,37 @@ bool cudaBackendAvailable(std::string* why = nullptr);
 std::unique_ptr<FrameBackend> makeFrameBackend(BackendKind kind, const Scene& scene);
 std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& scene);
 
+// What renderFrame gives back of the eyes' images.
+enum class FrameOutput : int {
+  HostImages = 0,     ///< copied to host memory (FrameResult::eyes)
+  DeviceBuffers = 1,  ///< left in GPU memory (Renderer::deviceImage); the host images stay empty
+};
+
+// photonvr for an application: a scene, a headset rig and options, and one call per frame.
+class Renderer {
+ public:
+  // The scene must outlive the renderer. Throws pvr::Error for BackendKind::Cuda without a GPU.
+  explicit Renderer(const Scene& scene, BackendKind backend = BackendKind::Auto);
+
+  StereoRig& rig() { return rig_; }  ///< the headset: eye size, IPD, per-eye FOV (starts as the scene's)
+  RenderOptions& options() { return options_; }
+
+  // Renders both eyes for a head pose (OpenXR's XrPosef conventions) and the left eye's gaze
+  // (image fractions; the right eye fixates what it meets). Throws OptionError for options out of
+  // range, pvr::Error for a failure (GPU out of memory included).
+  FrameResult renderFrame(const Pose& head, const float gaze[2] = nullptr, FrameOutput output = FrameOutput::HostImages);
+  // After a frame: an eye's displayed image in GPU memory (linear RGB floats, row-major, the
+  // rig's size), valid until the next frame; null on the CPU backend.
+  const Vec3* deviceImage(Eye eye) const { return frames_.deviceImage(eye); }
+  void resetHistory() { frames_.resetHistory(); }  ///< a cut: TAA starts again
+  std::string backendName() const { return frames_.name(); }
+  std::string deviceName() const { return frames_.deviceName(); }
+  FrameRenderer& frameRenderer() { return frames_; }
+
+ private:
+  StereoRig rig_;
+  RenderOptions options_;
+  FrameRenderer frames_;
+};
+
 }  // namespace pvr
