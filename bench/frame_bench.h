@@ -2,18 +2,22 @@
 // `photonvr bench` suites that time whole frames and the GPU's building blocks:
 //  - tables: the main paper's Tables 1-4 (kd-tree vs hash grid, heap vs no heap, single vs
 //    hybrid kernel, with vs without shared memory), every cell a full stereo frame (photons
-//    traced, map built, both eyes shaded) averaged over many frames after warm-up;
+//    traced, map built, both eyes shaded) timed over many frames after warm-up;
 //  - rays: rays per second of the CUDA traversal (primary, shadow, diffuse);
 //  - grid: the hash-grid build of 1M photons on the GPU;
 //  - stereo: the paper's empty Table 5, separate rendering against binocular reuse (scatter, the
-//    paper's; gather, ours), with the right eye's reuse fraction, cost and image quality.
+//    paper's; gather, ours), with the right eye's reuse fraction, cost and image quality;
+//  - foveation: foveated against full-resolution frames, and the temporal flicker with and without TAA.
 // Every suite checks its own results and says which GPU, resolution, photons and radius it ran.
+// Timings are tail latencies (one slow frame drops a frame in the headset): every frame cell keeps
+// each timed frame's wall time and stage times and reports their mean, p50, p99 and max
+// (latency_stats.h); the tables print mean / p99, the JSON has all four.
 #include <string>
 
 namespace pvr {
 
 struct FrameBenchArgs {
-  std::string suite = "tables";  ///< tables | rays | grid | stereo | all
+  std::string suite = "tables";  ///< tables | rays | grid | stereo | foveation | all
   std::string scene = "cornell";
   std::string raysScene = "cornell,cornell-dense";
   std::string backend = "auto";
@@ -21,7 +25,7 @@ struct FrameBenchArgs {
   std::string stereo = "separate,scatter,gather";  ///< Table 5's columns
   std::string stereoScenes = "cornell,cornell-caustics";  ///< Table 5 on the first; the others: one row
   std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
-  int frames = 100;
+  int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)
   int warmup = 10;
   int k = 32;
   std::string json;
