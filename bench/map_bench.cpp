@@ -2,14 +2,19 @@
 
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "pvr/cpu/cpu_backend.h"
 #include "bench_util.h"
+#include "latency_stats.h"
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
 
@@ -20,15 +25,31 @@ struct QueryPoint {
   Vec3 position, normal;
 };
 
+// The times of `repeats` runs of f(), in ms: the minimum (the figure the table reports) and the tail.
+struct RepeatTimes {
+  double min = 0;
+  LatencyStats stats;
+};
+
 template <class F>
-double minTimeMs(int repeats, F&& f) {
-  double best = INFINITY;
+RepeatTimes timeRepeats(int repeats, F&& f) {
+  std::vector<double> ms;
   for (int r = 0; r < repeats; ++r) {
     auto start = std::chrono::steady_clock::now();
     f();
-    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
-  return best;
+  RepeatTimes t;
+  t.min = ms.empty() ? 0.0 : *std::min_element(ms.begin(), ms.end());
+  t.stats = latencyStats(std::move(ms));
+  return t;
+}
+
+// A table cell: "min / p99".
+std::string minP99(const RepeatTimes& t) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.2f / %.2f", t.min, t.stats.p99);
+  return text;
 }
 
 uint32_t parseGrid(const std::string& s, uint32_t& nx, uint32_t& ny) {
@@ -106,10 +127,12 @@ int runMapBench(const MapBenchArgs& args) {
   int threads = tbb::info::default_concurrency();
   std::printf("photon-map benchmark, CPU backend: %s, %d threads\n", cpuName().c_str(), threads);
   std::printf("scene %s; %zu query points (diffuse first hits of the left eye on a %ux%u grid); kNN k=%d; "
-              "minimum of %d runs\n\n",
+              "minimum / p99 of %d runs (p99 by nearest rank: the max under 100 runs; mean, p50, p99 and max in the "
+              "JSON)\n\n",
               scene.name.c_str(), queries.size(), qw, qh, args.k, args.repeats);
-  std::printf("| photons | stored | radius | kd build ms | grid build ms | kd radius ms | grid radius ms | kd kNN ms | "
-              "grid kNN ms | photons/query | check |\n");
+  std::printf("| photons | stored | radius | kd build ms (min / p99) | grid build ms (min / p99) | kd radius ms (min / "
+              "p99) | grid radius ms (min / p99) | kd kNN ms (min / p99) | grid kNN ms (min / p99) | photons/query | "
+              "check |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
 
   nlohmann::json results = nlohmann::json::array();
@@ -120,17 +143,17 @@ int runMapBench(const MapBenchArgs& args) {
     tp.storeDirect = true;  // the paper's map holds every photon
     std::vector<Photon> photons = backend.tracePhotons(tp);
     KdTree tree;
-    double kdBuild = minTimeMs(args.repeats, [&] { tree = KdTree::build(photons); });
+    RepeatTimes kdBuild = timeRepeats(args.repeats, [&] { tree = KdTree::build(photons); });
     for (float radius : radii) {
       HashGrid grid;
-      double gridBuild = minTimeMs(args.repeats, [&] { grid = HashGrid::build(photons, radius); });
+      RepeatTimes gridBuild = timeRepeats(args.repeats, [&] { grid = HashGrid::build(photons, radius); });
       DensityParams radiusSum{radius, Estimator::Radius, args.k};
       DensityParams knn{radius, Estimator::Knn, args.k};
       std::vector<Vec3> kdR(queries.size()), gridR(queries.size()), kdK(queries.size()), gridK(queries.size());
-      double kdRadius = minTimeMs(args.repeats, [&] { estimateAll(tree.view(), queries, radiusSum, kdR); });
-      double gridRadius = minTimeMs(args.repeats, [&] { estimateAll(grid.view(), queries, radiusSum, gridR); });
-      double kdKnn = minTimeMs(args.repeats, [&] { estimateAll(tree.view(), queries, knn, kdK); });
-      double gridKnn = minTimeMs(args.repeats, [&] { estimateAll(grid.view(), queries, knn, gridK); });
+      RepeatTimes kdRadius = timeRepeats(args.repeats, [&] { estimateAll(tree.view(), queries, radiusSum, kdR); });
+      RepeatTimes gridRadius = timeRepeats(args.repeats, [&] { estimateAll(grid.view(), queries, radiusSum, gridR); });
+      RepeatTimes kdKnn = timeRepeats(args.repeats, [&] { estimateAll(tree.view(), queries, knn, kdK); });
+      RepeatTimes gridKnn = timeRepeats(args.repeats, [&] { estimateAll(grid.view(), queries, knn, gridK); });
       // Self-check: the two maps find the same photons, so the estimates agree up to the order of
       // the float additions.
       double diffRadius = maxRelativeDifference(kdR, gridR), diffKnn = maxRelativeDifference(kdK, gridK);
@@ -143,19 +166,26 @@ int runMapBench(const MapBenchArgs& args) {
         gv.search(q.position, r2, [&](uint32_t, float, float&) { found += 1; });
       }
       found /= std::max<size_t>(queries.size(), 1);
-      std::printf("| %ux%u | %zu | %.3g | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %s |\n", nx, ny,
-                  photons.size(), radius, kdBuild, gridBuild, kdRadius, gridRadius, kdKnn, gridKnn, found,
+      std::printf("| %ux%u | %zu | %.3g | %s | %s | %s | %s | %s | %s | %.0f | %s |\n", nx, ny, photons.size(), radius,
+                  minP99(kdBuild).c_str(), minP99(gridBuild).c_str(), minP99(kdRadius).c_str(),
+                  minP99(gridRadius).c_str(), minP99(kdKnn).c_str(), minP99(gridKnn).c_str(), found,
                   ok ? "ok" : "MISMATCH");
       std::fflush(stdout);
       results.push_back({{"photons", std::to_string(nx) + "x" + std::to_string(ny)},
                          {"stored_photons", photons.size()},
                          {"radius", radius},
-                         {"kd_build_ms", kdBuild},
-                         {"grid_build_ms", gridBuild},
-                         {"kd_radius_query_ms", kdRadius},
-                         {"grid_radius_query_ms", gridRadius},
-                         {"kd_knn_query_ms", kdKnn},
-                         {"grid_knn_query_ms", gridKnn},
+                         {"kd_build_ms", kdBuild.min},
+                         {"grid_build_ms", gridBuild.min},
+                         {"kd_radius_query_ms", kdRadius.min},
+                         {"grid_radius_query_ms", gridRadius.min},
+                         {"kd_knn_query_ms", kdKnn.min},
+                         {"grid_knn_query_ms", gridKnn.min},
+                         {"kd_build", kdBuild.stats},  // mean, p50, p99, max of the runs (the *_ms: their minimum)
+                         {"grid_build", gridBuild.stats},
+                         {"kd_radius_query", kdRadius.stats},
+                         {"grid_radius_query", gridRadius.stats},
+                         {"kd_knn_query", kdKnn.stats},
+                         {"grid_knn_query", gridKnn.stats},
                          {"photons_in_radius_per_query", found},
                          {"max_relative_difference_radius", diffRadius},
                          {"max_relative_difference_knn", diffKnn},
