@@ -365,7 +365,9 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   bench->add_option("--backend", fa.backend, "Backend of the tables suite: cpu | cuda | auto")->capture_default_str();
   bench->add_option("--tables", fa.tables, "Paper tables to run (tables suite)")->capture_default_str();
-  bench->add_option("--frames", fa.frames, "Frames averaged per cell (tables suite)")->capture_default_str();
+  bench->add_option("--frames", fa.frames,
+                    "Timed frames per cell (tables, stereo, foveation): mean, p50, p99 and max are reported")
+      ->capture_default_str();
   bench->add_option("--warmup", fa.warmup, "Warm-up frames per cell (tables suite)")->capture_default_str();
   bench->add_option("--eye-size", fa.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
   bench->add_option("--rays-scenes", fa.raysScene, "Scenes of the rays suite")->capture_default_str();
@@ -374,7 +376,7 @@ int runCli(int argc, char** argv) {
   bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye (maps suite)")
       ->capture_default_str();
   bench->add_option("--k", ba.k, "Photons per kNN query")->capture_default_str();
-  bench->add_option("--repeats", ba.repeats, "Timed repetitions, the minimum is reported (maps suite)")
+  bench->add_option("--repeats", ba.repeats, "Timed repetitions (maps suite): the minimum, and mean / p50 / p99 / max")
       ->capture_default_str();
   bench->add_option("--json", ba.json, "Also write the results as JSON to this file");
 

@@ -1,6 +1,6 @@
 #pragma once
-// The temporal stage on the GPU: each eye's history (its last displayed image, depth and camera) and the resolve
-// kernel over the shared per-pixel code (pvr/temporal/taa.h).
+// The temporal stage on the GPU: each eye's history (its last displayed image, depth and camera)
+// and the resolve kernel over the shared per-pixel code (pvr/temporal/taa.h).
 #include "pvr/cuda/cuda_util.cuh"
 #include "pvr/temporal/taa.h"
 
