@@ -87,6 +87,8 @@ class FrameDataflow {
  public:
   // Throws pvr::Error if the stage reads something not written yet; then marks its writes.
   void run(const StageIO& io);
+  // Throws pvr::Error naming `reader` (a step between stages, such as vergence) unless written.
+  void require(const DataRef& data, const char* reader) const;
   bool has(FrameData data, int eye = kWholeFrame) const { return written_[slot(data, eye)]; }
 
  private:

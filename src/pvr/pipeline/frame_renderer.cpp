@@ -60,12 +60,15 @@ StageIO temporalIO(Eye eye, bool foveated) {
   return io;
 }
 
+void FrameDataflow::require(const DataRef& r, const char* reader) const {
+  if (!has(r.data, r.eye))
+    throw Error(std::string("frame pipeline: ") + reader + " reads the " + frameDataName(r.data) +
+                (r.eye == kWholeFrame ? "" : r.eye == 0 ? " of the left eye" : " of the right eye") +
+                ", which no earlier stage of this frame wrote");
+}
+
 void FrameDataflow::run(const StageIO& io) {
-  for (const DataRef& r : io.reads)
-    if (!has(r.data, r.eye))
-      throw Error(std::string("frame pipeline: ") + stageName(io.stage) + " reads the " + frameDataName(r.data) +
-                  (r.eye == kWholeFrame ? "" : r.eye == 0 ? " of the left eye" : " of the right eye") +
-                  ", which no earlier stage of this frame wrote");
+  for (const DataRef& r : io.reads) require(r, stageName(io.stage));
   for (const DataRef& w : io.writes) written_[slot(w.data, w.eye)] = true;
 }
 
@@ -130,7 +133,7 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& opt
       if (eye == Eye::Right && foveation.verge) {
         float leftInverseDepth = 0.0f;
         if (options.eyes[0]) {
-          flow.run({Stage::EyeRays, {{FrameData::InverseDepth, 0}}, {}});
+          flow.require({FrameData::InverseDepth, int(Eye::Left)}, "vergence");
           leftInverseDepth = backend.inverseDepthAt(Eye::Left, foveation.gazePixelIndex(0, rig.width, rig.height));
         }
         vergeRightGaze(rig, foveation.gaze[0], options.eyes[0] ? &leftInverseDepth : nullptr, foveation.gaze[1]);
