@@ -44,18 +44,13 @@ void CpuFrameBackend::renderEyeWith(const EyePass& pass, const Map& map) {
   const EyeCamera& camera = pass.camera;
   const size_t pixels = size_t(camera.width) * camera.height;
   EyeBuffers& out = eyes_[e];
-  StereoReuseView reuse;
   SurfaceRecord* surfaces = nullptr;
   if (pass.role == StereoRole::Source) {
     sourceSurfaces_.assign(pixels, SurfaceRecord());  // foveated: only the vertices' pixels are written
     surfaces = sourceSurfaces_.data();
-  } else if (pass.role == StereoRole::Reuser) {
-    reuse.mode = pass.reuse;
-    reuse.source = pass.source;
-    reuse.sourceSurfaces = sourceSurfaces_.data();
-    reuse.sourceImage = eyes_[int(Eye::Left)].rendered.pixels.data();
-    if (pass.reuse == StereoMode::Scatter) reuse.scattered = scattered_.data();
   }
+  const StereoReuseView reuse =
+      reuseViewFor(pass, sourceSurfaces_.data(), eyes_[int(Eye::Left)].rendered.pixels.data(), scattered_.data());
 
   if (pass.foveated()) {
     std::vector<Vec3> colours;

@@ -68,11 +68,7 @@ StereoReuseView GpuEyePass::prepareReuse(const EyePass& pass, cudaStream_t strea
     out.surfaces = surfaces_.data();
     return reuse;
   }
-  reuse.mode = pass.reuse;
-  reuse.source = pass.source;
-  reuse.sourceSurfaces = surfaces_.data();
-  reuse.sourceImage = images_[int(Eye::Left)].data();
-  reuse.scattered = pass.reuse == StereoMode::Scatter ? scattered_.data() : nullptr;
+  reuse = reuseViewFor(pass, surfaces_.data(), images_[int(Eye::Left)].data(), scattered_.data());
   reusedCount_.reserve(1, "reuse count");
   PVR_CUDA_CHECK(cudaMemsetAsync(reusedCount_.data(), 0, sizeof(unsigned), stream));
   out.reusedCount = reusedCount_.data();

@@ -5,6 +5,4 @@ namespace pvr {
 
 enum class PhotonMapKind : int { HashGrid = 0, KdTree = 1 };
 
-inline const char* photonMapName(PhotonMapKind kind) { return kind == PhotonMapKind::HashGrid ? "hashgrid" : "kdtree"; }
-
 }  // namespace pvr

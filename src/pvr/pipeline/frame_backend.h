@@ -49,6 +49,20 @@ struct EyePass {
   bool foveated() const { return mask != nullptr; }
 };
 
+// What the pass reads of the eye it reuses, from that eye's buffers as the backend holds them
+// (host or device pointers); empty unless the pass is the reuser.
+inline StereoReuseView reuseViewFor(const EyePass& pass, const SurfaceRecord* sourceSurfaces, const Vec3* sourceImage,
+                                    const uint64_t* scattered) {
+  StereoReuseView reuse;
+  if (pass.role != StereoRole::Reuser) return reuse;
+  reuse.mode = pass.reuse;
+  reuse.source = pass.source;
+  reuse.sourceSurfaces = sourceSurfaces;
+  reuse.sourceImage = sourceImage;
+  reuse.scattered = pass.reuse == StereoMode::Scatter ? scattered : nullptr;
+  return reuse;
+}
+
 // Buffers that flow between stages. Photons, PhotonMap and the two surface buffers are the
 // frame's; the rest exist per eye.
 enum class FrameData : int {

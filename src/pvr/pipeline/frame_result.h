@@ -39,7 +39,6 @@ struct EyeResult {
   /// The right eye under stereo reuse at full resolution: per pixel, the left pixel whose
   /// shading it took (kNotReused: shaded here). Foveated reuse is per vertex and has none.
   std::optional<std::vector<uint32_t>> reusedFrom;
-  bool rendered() const { return !image.pixels.empty(); }
 };
 
 struct FrameResult {
