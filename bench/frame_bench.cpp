@@ -16,7 +16,7 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "bench_util.h"
-#include "latency_stats.h"
+#include "pvr/util/latency_stats.h"
 #include "pvr/util/error.h"
 #ifdef PVR_HAVE_CUDA
 #include "gpu_ray_throughput.h"

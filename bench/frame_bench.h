@@ -11,7 +11,7 @@
 // Every suite checks its own results and says which GPU, resolution, photons and radius it ran.
 // Timings are tail latencies (one slow frame drops a frame in the headset): every frame cell keeps
 // each timed frame's wall time and stage times and reports their mean, p50, p99 and max
-// (latency_stats.h); the tables print mean / p99, the JSON has all four.
+// (pvr/util/latency_stats.h); the tables print mean / p99, the JSON has all four.
 #include <string>
 
 namespace pvr {

@@ -14,7 +14,7 @@
 
 #include "pvr/cpu/cpu_backend.h"
 #include "bench_util.h"
-#include "latency_stats.h"
+#include "pvr/util/latency_stats.h"
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
 

@@ -7,6 +7,8 @@ packages=(
   libembree-dev libtbb-dev libassimp-dev libcgal-dev
   libcli11-dev nlohmann-json3-dev libstb-dev libopenexr-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libvulkan-dev mesa-vulkan-drivers libopenxr-dev libglfw3-dev libimgui-dev
+  xvfb xauth
 )
 missing=()
 for p in "${packages[@]}"; do

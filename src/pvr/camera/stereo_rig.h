@@ -82,16 +82,19 @@ struct EyeCamera {
 };
 
 // Head pose + IPD + per-eye FOV and resolution. Eyes sit at -/+ ipd/2 along the head's local X.
+// Each eye may be turned relative to the head (canted displays report per-view orientations);
+// both are the identity for parallel views.
 struct StereoRig {
   Pose head;
   float ipd = 0.063f;
   Fov fov[2];
   int width = 1440, height = 1600;
+  Quat eyeRotation[2];
 
   PVR_HOST_DEVICE EyeCamera eye(Eye e) const {
     float side = e == Eye::Left ? -0.5f : 0.5f;
     EyeCamera cam;
-    cam.pose.orientation = head.orientation;
+    cam.pose.orientation = head.orientation * eyeRotation[int(e)];
     cam.pose.position = head.toWorldPoint({side * ipd, 0.0f, 0.0f});
     cam.fov = fov[int(e)];
     cam.width = width;

@@ -218,6 +218,8 @@ const Vec3* CudaFrameBackend::deviceImage(Eye eye, bool displayed) const {
   return displayed ? impl_->temporal.image(eye) : impl_->eyePass.image(eye);
 }
 
+const float* CudaFrameBackend::deviceInverseDepth(Eye eye) const { return impl_->eyePass.inverseDepth(eye); }
+
 std::vector<Photon> CudaFrameBackend::tracePhotonsToHost(const PhotonTraceParams& params) {
   Impl& m = *impl_;
   uint32_t n = m.tracer.trace(m.deviceScene, params, m.stream);

@@ -46,6 +46,7 @@ class CudaFrameBackend : public FrameBackend {
   FrameCounters finishFrame() override;
   void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override;
   const Vec3* deviceImage(Eye eye, bool displayed) const override;
+  const float* deviceInverseDepth(Eye eye) const override;
 
   // Tools for tests and benchmarks.
   std::vector<Photon> tracePhotonsToHost(const PhotonTraceParams& params);

@@ -7,22 +7,24 @@
 #include <cmath>
 #include <filesystem>
 
+#include "pvr/image/display_encoding.h"
 #include "pvr/util/error.h"
 
 namespace pvr {
 
-float linearToSrgb(float v) {
-  v = std::clamp(std::isfinite(v) ? v : 0.0f, 0.0f, 1.0f);
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
+float linearToSrgb(float v) { return srgbEncode(v); }
 
 void writePng(const Image& image, const std::string& path, float exposure) {
   std::vector<unsigned char> bytes(size_t(image.width) * image.height * 3);
   for (size_t i = 0; i < image.pixels.size(); ++i)
     for (int c = 0; c < 3; ++c)
-      bytes[3 * i + c] = (unsigned char)std::lround(255.0f * linearToSrgb(image.pixels[i][c] * exposure));
-  if (!stbi_write_png(path.c_str(), image.width, image.height, 3, bytes.data(), image.width * 3))
-    throw Error("cannot write '" + path + "'");
+      bytes[3 * i + c] = (unsigned char)unorm8(linearToSrgb(image.pixels[i][c] * exposure));
+  writePngRgb(bytes, image.width, image.height, path);
+}
+
+void writePngRgb(const std::vector<unsigned char>& rgb, int width, int height, const std::string& path) {
+  if (rgb.size() != size_t(width) * height * 3) throw Error("cannot write '" + path + "': the image has the wrong size");
+  if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3)) throw Error("cannot write '" + path + "'");
 }
 
 void writeExr(const Image& image, const std::string& path) {

@@ -149,6 +149,8 @@ class FrameBackend {
   // The eye's image (displayed: after TAA) where it lies in GPU memory: linear RGB, row-major,
   // valid until the next frame; null for backends that render on the host.
   virtual const Vec3* deviceImage(Eye eye, bool displayed) const { return nullptr; }
+  // The last frame's per-pixel 1 / view depth of an eye in GPU memory; null on the CPU.
+  virtual const float* deviceInverseDepth(Eye eye) const { return nullptr; }
 };
 
 }  // namespace pvr

@@ -84,6 +84,10 @@ const Vec3* FrameRenderer::deviceImage(Eye eye) const {
   return rendered_[int(eye)] ? backend_->deviceImage(eye, displayed_[int(eye)]) : nullptr;
 }
 
+const float* FrameRenderer::deviceInverseDepth(Eye eye) const {
+  return rendered_[int(eye)] ? backend_->deviceInverseDepth(eye) : nullptr;
+}
+
 FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
   validateOptions(options, rig);
   rendered_[0] = rendered_[1] = false;

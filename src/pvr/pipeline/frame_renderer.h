@@ -27,6 +27,8 @@ class FrameRenderer {
   // The last frame's displayed image of an eye in GPU memory (linear RGB, row-major, the rig's
   // size), valid until the next frame; null on the CPU backend or for an eye not rendered.
   const Vec3* deviceImage(Eye eye) const;
+  // The same frame's per-pixel 1 / view depth (0: nothing hit) in GPU memory; null as above.
+  const float* deviceInverseDepth(Eye eye) const;
 
   std::string name() const { return backend_->name(); }  ///< "cpu" or "cuda"
   std::string deviceName() const { return backend_->deviceName(); }

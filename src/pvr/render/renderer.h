@@ -45,6 +45,9 @@ class Renderer {
   // After a frame: an eye's displayed image in GPU memory (linear RGB floats, row-major, the
   // rig's size), valid until the next frame; null on the CPU backend.
   const Vec3* deviceImage(Eye eye) const { return frames_.deviceImage(eye); }
+  const float* deviceInverseDepth(Eye eye) const { return frames_.deviceInverseDepth(eye); }  ///< 1 / view depth, as above
+  const StereoRig& rig() const { return rig_; }
+  const RenderOptions& options() const { return options_; }
   void resetHistory() { frames_.resetHistory(); }  ///< a cut: TAA starts again
   std::string backendName() const { return frames_.name(); }
   std::string deviceName() const { return frames_.deviceName(); }

@@ -1,0 +1,67 @@
+#pragma once
+// The CUDA side of handing eye images to a display without a host round trip: Vulkan memory and
+// semaphores exported as file descriptors, imported here (cudaImportExternalMemory /
+// cudaImportExternalSemaphore), and the kernel that encodes an eye's linear image and depth into
+// that memory in the display's format (image/display_encoding.h). A plain C++ header.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include "pvr/image/display_encoding.h"
+
+namespace pvr::cuda {
+
+// The UUID of the current CUDA device (to find the same GPU in Vulkan); false without a GPU.
+bool currentDeviceUuid(uint8_t uuid[16]);
+
+// A Vulkan allocation mapped into CUDA. Takes ownership of `fd` (CUDA closes it).
+class SharedBuffer {
+ public:
+  SharedBuffer(int fd, size_t allocationBytes, size_t usedBytes);
+  ~SharedBuffer();
+  SharedBuffer(const SharedBuffer&) = delete;
+  SharedBuffer& operator=(const SharedBuffer&) = delete;
+  void* data() const { return data_; }
+
+ private:
+  void* memory_ = nullptr;  // cudaExternalMemory_t
+  void* data_ = nullptr;
+};
+
+// A Vulkan (binary) semaphore that CUDA signals when its work on a stream is done.
+class SharedSemaphore {
+ public:
+  explicit SharedSemaphore(int fd);
+  ~SharedSemaphore();
+  SharedSemaphore(const SharedSemaphore&) = delete;
+  SharedSemaphore& operator=(const SharedSemaphore&) = delete;
+  void signal(void* stream);  // cudaStream_t
+
+ private:
+  void* semaphore_ = nullptr;  // cudaExternalSemaphore_t
+};
+
+// One stream with timing events for the hand-over's encoding kernels.
+class HandOverStream {
+ public:
+  HandOverStream();
+  ~HandOverStream();
+  HandOverStream(const HandOverStream&) = delete;
+  HandOverStream& operator=(const HandOverStream&) = delete;
+  void* stream() const { return stream_; }
+  void begin();             ///< records the start event
+  void end();               ///< records the end event
+  double lastMs();          ///< GPU time between the last begin and end (waits for end)
+
+ private:
+  void* stream_ = nullptr;
+  void* start_ = nullptr;
+  void* stop_ = nullptr;
+};
+
+// Encodes `pixels` of a linear image into `colour` (displayBytesPerPixel each) and, when both are
+// given, 1 / view depth into reversed-Z depth floats at `depth`. Asynchronous on `stream`.
+void encodeEyeForDisplay(const Vec3* image, const float* inverseDepth, size_t pixels, float exposure,
+                         DisplayEncoding encoding, float nearZ, void* colour, float* depth, void* stream);
+
+}  // namespace pvr::cuda

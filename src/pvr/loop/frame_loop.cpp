@@ -1,0 +1,63 @@
+#include "pvr/loop/frame_loop.h"
+
+namespace pvr {
+namespace {
+
+double msBetween(LoopClock::time_point a, LoopClock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+}  // namespace
+
+FrameStats FrameLoop::run(const FrameLoopOptions& options) {
+  FrameStats stats;
+  FrameRequest request;
+  request.rig = renderer_.rig();
+  uint64_t rendered = 0;
+  bool stopRequested = false;
+  std::optional<LoopClock::time_point> previousStart;
+  for (;;) {
+    const bool stopNow = (options.stop && options.stop->load()) ||
+                         (options.maxFrames && rendered >= options.maxFrames + options.warmupFrames);
+    if (stopNow && !stopRequested) {
+      presenter_.requestStop();
+      stopRequested = true;
+    }
+    LoopClock::time_point waitStart = LoopClock::now();
+    if (!presenter_.waitFrame(request)) break;
+    LoopClock::time_point start = LoopClock::now();
+    presenter_.adjustOptions(renderer_.options());
+    FrameRecord record;
+    record.waitMs = msBetween(waitStart, start);
+    record.intervalMs = previousStart ? msBetween(*previousStart, start) : 0.0;
+    previousStart = start;
+    const FrameOutput output = presenter_.output(renderer_);
+    if (!request.shouldRender || stopRequested) {  // the display wants a frame, but not its content
+      presenter_.present({request, nullptr, renderer_, false});
+      stats.addSkipped();
+      continue;
+    }
+    renderer_.rig() = request.rig;
+    renderer_.options().foveation.verge = request.verge;
+    std::copy(&request.gaze[0][0], &request.gaze[0][0] + 4, &renderer_.options().foveation.gaze[0][0]);
+    FrameResult frame = renderer_.renderFrame(request.rig.head, nullptr, output);
+    LoopClock::time_point rendered_at = LoopClock::now();
+    presenter_.present({request, &frame, renderer_, output == FrameOutput::DeviceBuffers});
+    LoopClock::time_point done = LoopClock::now();
+    record.renderMs = msBetween(start, rendered_at);
+    record.presentMs = msBetween(rendered_at, done);
+    record.cpuMs = record.renderMs + record.presentMs;
+    record.stages = frame.timings;
+    record.gpuMs = frame.timings.totalMs();
+    record.overheadMs = record.cpuMs - record.gpuMs;
+    if (request.deadline) {
+      record.hasDeadline = true;
+      record.slackMs = msBetween(done, *request.deadline);
+      record.missedDeadline = done > *request.deadline;
+    }
+    if (rendered++ >= options.warmupFrames) stats.add(record);
+  }
+  return stats;
+}
+
+}  // namespace pvr

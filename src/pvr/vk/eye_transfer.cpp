@@ -1,0 +1,270 @@
+#include "pvr/vk/eye_transfer.h"
+
+#include <chrono>
+
+#include "pvr/util/error.h"
+#include "pvr/util/parallel_for.h"
+#ifdef PVR_HAVE_CUDA
+#include "pvr/cuda/display_handover.h"
+#endif
+
+namespace pvr {
+
+const char* handOverPathName(HandOverPath path) {
+  return path == HandOverPath::CudaShared ? "CUDA to Vulkan, shared memory" : "host staging buffer";
+}
+
+bool encodingOfFormat(VkFormat format, DisplayEncoding& encoding) {
+  switch (format) {
+    case VK_FORMAT_R8G8B8A8_SRGB: encoding = DisplayEncoding::Rgba8Srgb; return true;
+    case VK_FORMAT_B8G8R8A8_SRGB: encoding = DisplayEncoding::Bgra8Srgb; return true;
+    case VK_FORMAT_R8G8B8A8_UNORM: encoding = DisplayEncoding::Rgba8Linear; return true;
+    case VK_FORMAT_B8G8R8A8_UNORM: encoding = DisplayEncoding::Bgra8Linear; return true;
+    case VK_FORMAT_R16G16B16A16_SFLOAT: encoding = DisplayEncoding::Rgba16Float; return true;
+    default: return false;
+  }
+}
+
+struct EyeTransfer::Slot {
+  VulkanBuffer colour[2], depth[2];
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  bool submitted = false;
+#ifdef PVR_HAVE_CUDA
+  std::unique_ptr<cuda::SharedBuffer> cudaColour[2], cudaDepth[2];
+  std::unique_ptr<cuda::SharedSemaphore> encoded;
+#endif
+  VkSemaphore encodedSemaphore = VK_NULL_HANDLE;  ///< CUDA signals it, the copy waits on it
+};
+
+struct EyeTransfer::CudaState {
+#ifdef PVR_HAVE_CUDA
+  cuda::HandOverStream stream;
+#endif
+  PFN_vkGetMemoryFdKHR getMemoryFd = nullptr;
+  PFN_vkGetSemaphoreFdKHR getSemaphoreFd = nullptr;
+};
+
+EyeTransfer::EyeTransfer(VulkanContext& vk, const EyeTransferOptions& options) : vk_(vk), options_(options) {
+  if (options.width <= 0 || options.height <= 0) throw Error("eye transfer: the eye size must be positive");
+  const bool shared = options.path == HandOverPath::CudaShared;
+#ifndef PVR_HAVE_CUDA
+  if (shared) throw Error("this build of photonvr has no CUDA backend to share memory with Vulkan");
+#endif
+  if (shared && !vk.canShareWithCuda())
+    throw Error("the Vulkan device '" + vk.deviceName() + "' cannot share memory with CUDA (VK_KHR_external_memory_fd)");
+  if (shared) {
+    cuda_ = std::make_unique<CudaState>();
+    cuda_->getMemoryFd = reinterpret_cast<PFN_vkGetMemoryFdKHR>(vkGetDeviceProcAddr(vk.device(), "vkGetMemoryFdKHR"));
+    cuda_->getSemaphoreFd = reinterpret_cast<PFN_vkGetSemaphoreFdKHR>(vkGetDeviceProcAddr(vk.device(), "vkGetSemaphoreFdKHR"));
+    if (!cuda_->getMemoryFd || !cuda_->getSemaphoreFd) throw Error("the Vulkan driver does not export memory as file descriptors");
+  }
+  const size_t pixels = size_t(options.width) * options.height;
+  const VkDeviceSize colourBytes = pixels * displayBytesPerPixel(options.encoding), depthBytes = pixels * sizeof(float);
+  for (int s = 0; s < 2; ++s) {
+    auto slot = std::make_unique<Slot>();
+    for (int e = 0; e < 2; ++e) {
+      if (shared) {
+        slot->colour[e] = makeExportableBuffer(vk, colourBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        if (options.depth) slot->depth[e] = makeExportableBuffer(vk, depthBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+#ifdef PVR_HAVE_CUDA
+        auto import = [&](const VulkanBuffer& b) {
+          VkMemoryGetFdInfoKHR info{VK_STRUCTURE_TYPE_MEMORY_GET_FD_INFO_KHR};
+          info.memory = b.memory;
+          info.handleType = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+          int fd = -1;
+          vkCheck(cuda_->getMemoryFd(vk.device(), &info, &fd), "vkGetMemoryFdKHR");
+          return std::make_unique<cuda::SharedBuffer>(fd, size_t(b.allocationSize), size_t(b.size));
+        };
+        slot->cudaColour[e] = import(slot->colour[e]);
+        if (options.depth) slot->cudaDepth[e] = import(slot->depth[e]);
+#endif
+      } else {
+        slot->colour[e] = makeHostBuffer(vk, colourBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        if (options.depth) slot->depth[e] = makeHostBuffer(vk, depthBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+      }
+    }
+    if (shared) {
+      VkExportSemaphoreCreateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_SEMAPHORE_CREATE_INFO};
+      exportInfo.handleTypes = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+      VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+      sci.pNext = &exportInfo;
+      vkCheck(vkCreateSemaphore(vk.device(), &sci, nullptr, &slot->encodedSemaphore), "vkCreateSemaphore");
+#ifdef PVR_HAVE_CUDA
+      VkSemaphoreGetFdInfoKHR info{VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR};
+      info.semaphore = slot->encodedSemaphore;
+      info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+      int fd = -1;
+      vkCheck(cuda_->getSemaphoreFd(vk.device(), &info, &fd), "vkGetSemaphoreFdKHR");
+      slot->encoded = std::make_unique<cuda::SharedSemaphore>(fd);
+#endif
+    }
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = vk.commandPool();
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    vkCheck(vkAllocateCommandBuffers(vk.device(), &ai, &slot->cmd), "vkAllocateCommandBuffers");
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    vkCheck(vkCreateFence(vk.device(), &fci, nullptr, &slot->fence), "vkCreateFence");
+    slots_.push_back(std::move(slot));
+  }
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(vk.physicalDevice(), &props);
+  timestampPeriodNs_ = props.limits.timestampPeriod;
+  if (props.limits.timestampComputeAndGraphics) {
+    VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qci.queryCount = 4;
+    vkCheck(vkCreateQueryPool(vk.device(), &qci, nullptr, &timestamps_), "vkCreateQueryPool");
+  }
+}
+
+EyeTransfer::~EyeTransfer() {
+  vkDeviceWaitIdle(vk_.device());
+  for (auto& slot : slots_) {
+    vkDestroyFence(vk_.device(), slot->fence, nullptr);
+    vkFreeCommandBuffers(vk_.device(), vk_.commandPool(), 1, &slot->cmd);
+#ifdef PVR_HAVE_CUDA
+    slot->encoded.reset();
+    for (int e = 0; e < 2; ++e) slot->cudaColour[e].reset(), slot->cudaDepth[e].reset();
+#endif
+    if (slot->encodedSemaphore) vkDestroySemaphore(vk_.device(), slot->encodedSemaphore, nullptr);
+  }
+  if (timestamps_) vkDestroyQueryPool(vk_.device(), timestamps_, nullptr);
+}
+
+namespace {
+
+void waitFence(VkDevice device, VkFence fence) {
+  VkResult r = vkWaitForFences(device, 1, &fence, VK_TRUE, 5'000'000'000ull);
+  if (r == VK_TIMEOUT) throw Error("Vulkan: the copy of an eye image did not finish within 5 s");
+  vkCheck(r, "vkWaitForFences (eye copy)");
+}
+
+}  // namespace
+
+void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2], VkSemaphore signal) {
+  Slot& slot = *slots_[next_];
+  const size_t slotIndex = next_;
+  if (slot.submitted) {  // the GPU may still copy from this slot's buffers
+    waitFence(vk_.device(), slot.fence);
+    slot.submitted = false;
+  }
+  const size_t pixels = size_t(options_.width) * options_.height;
+  const int bpp = displayBytesPerPixel(options_.encoding);
+  bool anyCuda = false;
+  auto hostStart = std::chrono::steady_clock::now();
+  for (int e = 0; e < 2; ++e) {
+    const EyeSource& src = source[e];
+    if (!src.present() || !target[e].colour) continue;
+    if (src.deviceImage) {
+#ifdef PVR_HAVE_CUDA
+      if (!cuda_) throw Error("eye transfer: GPU images need the CUDA hand-over path");
+      if (!anyCuda) cuda_->stream.begin();
+      anyCuda = true;
+      cuda::encodeEyeForDisplay(src.deviceImage, options_.depth ? src.deviceInverseDepth : nullptr, pixels,
+                                options_.exposure, options_.encoding, options_.nearZ, slot.cudaColour[e]->data(),
+                                options_.depth ? static_cast<float*>(slot.cudaDepth[e]->data()) : nullptr,
+                                cuda_->stream.stream());
+#else
+      throw Error("eye transfer: GPU images without a CUDA build");
+#endif
+      continue;
+    }
+    if (cuda_) throw Error("eye transfer: the CUDA hand-over path takes GPU images, not host images");
+    const Image& image = *src.image;
+    if (image.width != options_.width || image.height != options_.height)
+      throw Error("eye transfer: the eye image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                  ", the display's " + std::to_string(options_.width) + "x" + std::to_string(options_.height));
+    unsigned char* colour = static_cast<unsigned char*>(slot.colour[e].mapped);
+    float* depth = options_.depth ? static_cast<float*>(slot.depth[e].mapped) : nullptr;
+    const std::vector<float>* inverseDepth = src.inverseDepth;
+    const float exposure = options_.exposure, nearZ = options_.nearZ;
+    const DisplayEncoding encoding = options_.encoding;
+    parallelFor("display hand-over encode", pixels, 16384, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        encodeDisplayPixel(image.pixels[i], exposure, encoding, colour + i * bpp);
+        if (depth) depth[i] = inverseDepth && i < inverseDepth->size() ? reversedDepth((*inverseDepth)[i], nearZ) : 0.0f;
+      }
+    });
+  }
+  lastHostEncodeMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - hostStart).count();
+#ifdef PVR_HAVE_CUDA
+  if (anyCuda) {
+    cuda_->stream.end();
+    slot.encoded->signal(cuda_->stream.stream());
+  }
+#endif
+
+  VkCommandBuffer cmd = slot.cmd;
+  vkCheck(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  vkCheck(vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
+  const uint32_t query = uint32_t(slotIndex) * 2;
+  if (timestamps_) {
+    vkCmdResetQueryPool(cmd, timestamps_, query, 2);
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, query);
+  }
+  for (int e = 0; e < 2; ++e) {
+    if (!source[e].present() || !target[e].colour) continue;
+    VkBufferImageCopy region{};
+    region.imageExtent = {uint32_t(options_.width), uint32_t(options_.height), 1};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    transitionImage(cmd, target[e].colour, VK_IMAGE_ASPECT_COLOR_BIT, target[e].colourLayout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    vkCmdCopyBufferToImage(cmd, slot.colour[e].buffer, target[e].colour, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    transitionImage(cmd, target[e].colour, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, target[e].colourLayout);
+    if (options_.depth && target[e].depth) {
+      region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+      transitionImage(cmd, target[e].depth, VK_IMAGE_ASPECT_DEPTH_BIT, target[e].depthLayout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+      vkCmdCopyBufferToImage(cmd, slot.depth[e].buffer, target[e].depth, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+      transitionImage(cmd, target[e].depth, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, target[e].depthLayout);
+    }
+  }
+  if (timestamps_) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, query + 1);
+  vkCheck(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  vkCheck(vkResetFences(vk_.device(), 1, &slot.fence), "vkResetFences");
+  VkPipelineStageFlags waitStage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  if (anyCuda) {
+    si.waitSemaphoreCount = 1;
+    si.pWaitSemaphores = &slot.encodedSemaphore;
+    si.pWaitDstStageMask = &waitStage;
+  }
+  if (signal) {
+    si.signalSemaphoreCount = 1;
+    si.pSignalSemaphores = &signal;
+  }
+  vkCheck(vkQueueSubmit(vk_.queue(), 1, &si, slot.fence), "vkQueueSubmit (eye copy)");
+  slot.submitted = true;
+  timestampsValid_ = timestamps_ != VK_NULL_HANDLE;
+  last_ = slotIndex;
+  next_ = (next_ + 1) % slots_.size();
+}
+
+HandOverTiming EyeTransfer::lastTiming() {
+  HandOverTiming t;
+  t.hostEncodeMs = lastHostEncodeMs_;
+  Slot& slot = *slots_[last_];
+  if (!slot.submitted) return t;
+  waitFence(vk_.device(), slot.fence);
+  if (timestampsValid_) {
+    uint64_t ticks[2] = {0, 0};
+    if (vkGetQueryPoolResults(vk_.device(), timestamps_, uint32_t(last_) * 2, 2, sizeof ticks, ticks, sizeof(uint64_t),
+                              VK_QUERY_RESULT_64_BIT) == VK_SUCCESS)
+      t.copyMs = double(ticks[1] - ticks[0]) * timestampPeriodNs_ * 1e-6;
+  }
+#ifdef PVR_HAVE_CUDA
+  if (cuda_) t.encodeMs = cuda_->stream.lastMs();
+#endif
+  return t;
+}
+
+void EyeTransfer::waitIdle() {
+  for (auto& slot : slots_)
+    if (slot->submitted) waitFence(vk_.device(), slot->fence), slot->submitted = false;
+}
+
+}  // namespace pvr
