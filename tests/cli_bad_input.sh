@@ -94,6 +94,29 @@ expect_error "" render cornell --no-such-option
 expect_error "" frobnicate
 expect_error "" bench cornell --k 0
 
+# The frame loop's commands: no runtime, no display, bad loop options, bad settings files.
+XR_RUNTIME_JSON="$out/no-such-runtime.json" expect_error "no OpenXR runtime" xr --backend cpu --frames 1
+DISPLAY= WAYLAND_DISPLAY= expect_error "no display" view --backend cpu --eye-size 8x8
+expect_error "--keys entries are FRAME:KEY" view --backend cpu --keys F12
+expect_error "unknown key" view --backend cpu --keys 3:F13
+expect_error "--handover must be" xr --offscreen --backend cpu --eye-size 8x8 --photons 16x16 --frames 1 --handover pcie --stats ""
+expect_error "refresh rate" xr --offscreen --backend cpu --eye-size 8x8 --photons 16x16 --frames 1 --refresh 0 --stats ""
+VK_DRIVER_FILES="$out/none.json" VK_ICD_FILENAMES="$out/none.json" expect_error "no Vulkan driver" xr --offscreen --backend cpu --eye-size 8x8 --photons 16x16 --frames 1 --stats ""
+expect_error "--near must be" xr --offscreen --backend cpu --near -1 --frames 1
+expect_error "--ready-timeout must be" xr --backend cpu --ready-timeout 0 --frames 1
+expect_error "cannot read settings file" render --settings "$out/none.json" "${small[@]}"
+echo '{"radius": ' >"$out/broken.json"
+expect_error "not valid JSON" render --settings "$out/broken.json" "${small[@]}"
+echo '[1, 2]' >"$out/array.json"
+expect_error "must hold a JSON object" render --settings "$out/array.json" "${small[@]}"
+echo '{"head": {"position": [0, 1], "orientation": [0, 0, 0, 1]}}' >"$out/short.json"
+expect_error "wrong type or is missing" render --settings "$out/short.json" "${small[@]}"
+echo '{"head": {"position": [0, 1, 2], "orientation": [0, 0, 0, 0]}}' >"$out/zero.json"
+expect_error "non-zero quaternion" render --settings "$out/zero.json" "${small[@]}"
+echo '{"radius": "-1"}' >"$out/radius.json"
+expect_error "radius" render --settings "$out/radius.json" "${small[@]}"
+expect_error "--acuity must be" render cornell --foveated --acuity sharp "${small[@]}"
+
 # NaN vertices and degenerate triangles: a warning, and the render goes on.
 "$exe" render "$data/nan_and_degenerate.obj" "${small[@]}" >"$out/stdout" 2>"$out/stderr"
 rc=$?

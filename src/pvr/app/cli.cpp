@@ -8,10 +8,16 @@
 #include <new>
 #include <memory>
 #include <regex>
+#include <csignal>
+#include <fstream>
+#include <optional>
+
+#include <nlohmann/json.hpp>
 
 #include "frame_bench.h"
 #include "pvr/app/options.h"
 #include "pvr/foveation/mask.h"
+#include "pvr/app/loop_commands.h"
 #include "pvr/app/trajectory.h"
 #include "map_bench.h"
 #include "pvr/image/image_io.h"
@@ -82,7 +88,67 @@ struct RenderArgs {
   std::string taaBlend;      // empty: TaaParams' default
   std::string out = "out/render";
   float exposure = 1.0f;
+  std::string acuity = "linear";  // the mask made at start under --foveated
+  std::string settings;           // JSON settings file (the viewer writes them)
+  std::optional<Pose> head;       // from the settings file
 };
+
+// The settings file: the command line's options by name ("radius": "0.05"), the head pose and the
+// gaze. Options given on the command line win over the file's.
+void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read settings file '" + path + "'");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw Error("settings file '" + path + "' is not valid JSON: " + std::string(e.what()).substr(0, 120));
+  }
+  if (!j.is_object()) throw Error("settings file '" + path + "' must hold a JSON object");
+  auto given = [&](const char* flag) { return cmd.count(flag) > 0; };
+  try {
+    auto text = [&](const char* key, const char* flag, std::string& field) {
+      if (j.contains(key) && !given(flag)) field = j[key].is_string() ? j[key].get<std::string>() : j[key].dump();
+    };
+    auto flag = [&](const char* key, const char* f, bool& field) {
+      if (j.contains(key) && !given(f)) field = j[key].get<bool>();
+    };
+    text("photons", "--photons", a.photons);
+    text("radius", "--radius", a.radius);
+    text("map", "--map", a.map);
+    text("estimator", "--estimator", a.estimator);
+    text("kernel", "--kernel", a.kernel);
+    text("backend", "--backend", a.backend);
+    text("stereo", "--stereo", a.stereo);
+    text("eye_size", "--eye-size", a.eyeSize);
+    text("ipd", "--ipd", a.ipd);
+    text("gaze", "--gaze", a.gaze);
+    text("acuity", "--acuity", a.acuity);
+    text("taa_blend", "--taa-blend", a.taaBlend);
+    flag("foveated", "--foveated", a.foveated);
+    flag("taa", "--taa", a.taa);
+    if (j.contains("k") && !given("--k")) a.k = j["k"].get<int>();
+    if (j.contains("exposure") && !given("--exposure")) a.exposure = j["exposure"].get<float>();
+    if (j.contains("scene") && !given("scene")) a.scene = j["scene"].get<std::string>();
+    if (j.contains("head")) {
+      const auto& p = j["head"].at("position");
+      const auto& q = j["head"].at("orientation");
+      Pose head;
+      head.position = {p.at(0).get<float>(), p.at(1).get<float>(), p.at(2).get<float>()};
+      head.orientation = {q.at(0).get<float>(), q.at(1).get<float>(), q.at(2).get<float>(), q.at(3).get<float>()};
+      float n = std::sqrt(head.orientation.x * head.orientation.x + head.orientation.y * head.orientation.y +
+                          head.orientation.z * head.orientation.z + head.orientation.w * head.orientation.w);
+      if (!(n > 1e-6f) || !std::isfinite(n) || !std::isfinite(head.position.x + head.position.y + head.position.z))
+        throw Error("the head pose must be finite with a non-zero quaternion");
+      head.orientation = {head.orientation.x / n, head.orientation.y / n, head.orientation.z / n, head.orientation.w / n};
+      a.head = head;
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error("settings file '" + path + "': a value has the wrong type or is missing (" + std::string(e.what()).substr(0, 100) + ")");
+  } catch (const Error& e) {
+    throw Error("settings file '" + path + "': " + e.what());
+  }
+}
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--photons", a.photons, "Emitted photons as WxH (the paper's 128x128 .. 512x512) or a count")
@@ -148,12 +214,30 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   return o;
 }
 
-int runRender(const RenderArgs& a) {
-  BackendKind backendKind = parseBackendKind(a.backend);
-  Scene scene = loadScene(a.scene);
-  StereoRig rig = scene.rig;
-  RenderOptions options = toOptions(a, rig);
+// What every command that renders needs, made from the options: the scene, the rig, the
+// validated options and the foveation mask they point at.
+struct RenderSetup {
+  BackendKind backend = BackendKind::Auto;
+  Scene scene;
+  StereoRig rig;
+  RenderOptions options;
   FoveationMask mask;
+  std::vector<TrajectoryFrame> trajectory;
+};
+
+std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
+  auto setup = std::make_unique<RenderSetup>();
+  setup->backend = parseBackendKind(a.backend);
+  setup->scene = loadScene(a.scene);
+  Scene& scene = setup->scene;
+  StereoRig& rig = setup->rig;
+  rig = scene.rig;
+  if (a.head) rig.head = *a.head;
+  RenderOptions& options = setup->options;
+  options = toOptions(a, rig);
+  FoveationMask& mask = setup->mask;
+  if (a.acuity != "linear" && a.acuity != "geisler-perry")
+    throw Error("--acuity must be linear or geisler-perry, got '" + a.acuity + "'");
   if (a.foveated) {
     float gx = 0, gy = 0;
     char extra = 0;
@@ -161,7 +245,9 @@ int runRender(const RenderArgs& a) {
       throw Error("--gaze must be X,Y (image fractions, 0.5,0.5 = centre), got '" + a.gaze + "'");
     options.foveation.gaze[0][0] = gx, options.foveation.gaze[0][1] = gy;
     validateOptions(options, rig);  // before the mask is made: a bad gaze need not wait for it
-    mask = a.mask.empty() ? generateFoveationMask(maskParamsForRig(rig)) : loadFoveationMask(a.mask);
+    MaskParams params = maskParamsForRig(rig);
+    if (a.acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
+    mask = a.mask.empty() ? generateFoveationMask(params) : loadFoveationMask(a.mask);
     options.foveation.mask = &mask;
     options.foveation.verge = true;  // both eyes fixate what the left eye's gaze meets
   } else if (!a.mask.empty()) {
@@ -173,13 +259,22 @@ int runRender(const RenderArgs& a) {
     if (!a.taaBlend.empty()) options.temporal.taa.blend = parseFloat(a.taaBlend, "--taa-blend");
   }
   validateOptions(options, rig);  // all of them, before any work
-  std::vector<TrajectoryFrame> trajectory;
-  if (!a.trajectory.empty()) trajectory = loadTrajectory(a.trajectory);
-  ensureParentDirectory(a.out);  // before the work, not after it
+  if (!a.trajectory.empty()) setup->trajectory = loadTrajectory(a.trajectory);
   if (scene.skippedTriangles() > 0)
     std::cerr << "photonvr: warning: skipped " << scene.skippedTriangles()
               << " degenerate or non-finite triangles\n";
-  std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(backendKind, scene);
+  return setup;
+}
+
+int runRender(const RenderArgs& a) {
+  std::unique_ptr<RenderSetup> setup = setUpRender(a);
+  Scene& scene = setup->scene;
+  StereoRig& rig = setup->rig;
+  RenderOptions& options = setup->options;
+  const FoveationMask& mask = setup->mask;
+  const std::vector<TrajectoryFrame>& trajectory = setup->trajectory;
+  ensureParentDirectory(a.out);  // before the work, not after it
+  std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(setup->backend, scene);
   std::printf("scene %s: %u triangles, %u emitting; eyes %dx%d, IPD %.1f mm\n", scene.name.c_str(),
               scene.triangleCount(), scene.lightTriangleCount(), rig.width, rig.height, rig.ipd * 1000.0f);
   std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, seed %u\n", options.photonsX,
@@ -348,6 +443,56 @@ int runCli(int argc, char** argv) {
   render->add_option("--out", ra.out, "Output prefix: writes PREFIX_left.png/.exr and PREFIX_right.png/.exr")
       ->capture_default_str();
 
+  render->add_option("--acuity", ra.acuity, "Acuity model of the mask made under --foveated: linear | geisler-perry")
+      ->capture_default_str();
+  render->add_option("--settings", ra.settings,
+                     "Settings file (JSON, written by `photonvr view` with F12): options, head pose and gaze; flags given here win");
+
+  // xr and view: the same rendering options, and the loop's.
+  RenderArgs xa, va;
+  LoopCommandArgs xl, vl;
+  CLI::App* xr = app.add_subcommand(
+      "xr", "Run on an OpenXR headset (any runtime: SteamVR, Monado, Meta's; XR_KHR_vulkan_enable2), or --offscreen without one; "
+            "writes per-frame statistics (p50/p99/max) as JSON");
+  CLI::App* view = app.add_subcommand(
+      "view", "Interactive desktop viewer (GLFW + Dear ImGui on Vulkan): both eyes, mouse-look, WASD, gaze under the cursor, "
+              "every option live; F12 writes a screenshot and a settings file");
+  for (auto [cmd, a] : {std::pair{xr, &xa}, std::pair{view, &va}}) {
+    cmd->add_option("scene", a->scene, "Built-in scene name or scene/mesh file")->capture_default_str();
+    addRenderOptions(*cmd, *a);
+    cmd->add_option("--eye-size", a->eyeSize, cmd == xr ? "Per-eye size WxH (default: the runtime's recommended size)"
+                                                        : "Per-eye size WxH (default: 640x712)");
+    cmd->add_option("--ipd", a->ipd, "Interpupillary distance in metres (view, --offscreen; a headset reports its own)");
+    cmd->add_option("--spp", a->spp, "Samples per pixel")->capture_default_str();
+    cmd->add_option("--specular-depth", a->specularDepth, "Mirror/glass bounces followed from the eye")->capture_default_str();
+    cmd->add_option("--exposure", a->exposure, "Scale applied before display encoding")->capture_default_str();
+    cmd->add_flag("--foveated", a->foveated, "Foveated rendering around the gaze");
+    cmd->add_option("--acuity", a->acuity, "Acuity model of the foveation mask: linear | geisler-perry")->capture_default_str();
+    cmd->add_option("--gaze", a->gaze, "Gaze X,Y (image fractions) when no eye tracker gives one")->capture_default_str();
+    cmd->add_flag("--taa", a->taa, "Temporal anti-aliasing across the loop's frames");
+    cmd->add_option("--taa-blend", a->taaBlend, "Weight of the current frame under --taa, in (0, 1]");
+    cmd->add_option("--settings", a->settings, "Settings file (JSON) from `photonvr view`; flags given here win");
+  }
+  xr->add_option("--frames", xl.frames, "Frames to render, then end the session cleanly (0: until the runtime ends it or Ctrl-C)")
+      ->capture_default_str();
+  xr->add_option("--warmup", xl.warmup, "Frames rendered before the statistics start")->capture_default_str();
+  xr->add_option("--stats", xl.stats, "Per-frame statistics as JSON (written on exit)")->capture_default_str();
+  xr->add_flag("--offscreen", xl.offscreen, "No runtime: the same loop with views from --trajectory (or the scene's) in display slots");
+  xr->add_option("--trajectory", xa.trajectory, "Offscreen: head poses and gaze, one frame per line (cycled)");
+  xr->add_option("--handover", xl.handOver, "Offscreen: vulkan (hand the eyes to Vulkan images, timed) | none")->capture_default_str();
+  xr->add_option("--refresh", xl.refreshHz, "Offscreen: display refresh rate in Hz (a frame later than its slot misses)")
+      ->capture_default_str();
+  xr->add_flag("--paced", xl.paced, "Offscreen: wait for each display slot as vsync would");
+  xr->add_flag("--stage", xl.stage, "STAGE reference space (floor origin) instead of LOCAL (the head at start)");
+  xr->add_flag("!--no-depth", xl.depthLayer, "Do not submit a depth layer");
+  xr->add_option("--near", xl.nearZ, "Metres at depth 1 of the depth layer (reversed Z, infinite far)")->capture_default_str();
+  xr->add_option("--ready-timeout", xl.readyTimeout, "Seconds the session may take to become READY")->capture_default_str();
+  view->add_option("--frames", vl.frames, "Frames to show, then close (0: until the window is closed)")->capture_default_str();
+  view->add_option("--screenshot", vl.screenshot, "Prefix of what F12 writes: PREFIX_left/right.png, PREFIX.json, PREFIX_window.png")
+      ->capture_default_str();
+  view->add_option("--keys", vl.keys, "Scripted key presses FRAME:KEY,... (e.g. 3:F12,5:Escape)");
+  view->add_flag("--no-panel", vl.noPanel, "No options panel");
+
   MapBenchArgs ba;
   FrameBenchArgs fa;
   CLI::App* bench = app.add_subcommand(
@@ -396,7 +541,29 @@ int runCli(int argc, char** argv) {
   try {
     app.parse(argc, argv);
     if (maskCmd->parsed()) return runMask(ma);
-    if (render->parsed()) return runRender(ra);
+    if (render->parsed()) {
+      if (!ra.settings.empty()) applySettings(ra.settings, ra, *render);
+      return runRender(ra);
+    }
+    for (auto [cmd, a, l] : {std::tuple{xr, &xa, &xl}, std::tuple{view, &va, &vl}}) {
+      if (!cmd->parsed()) continue;
+      if (!a->settings.empty()) applySettings(a->settings, *a, *cmd);
+      if (cmd == view && a->eyeSize.empty()) a->eyeSize = "640x712";
+      l->eyeSizeGiven = !a->eyeSize.empty();
+      l->exposure = a->exposure;
+      l->sceneName = a->scene;
+      l->acuity = a->acuity;
+      if (!(l->nearZ > 0.0f) || !std::isfinite(l->nearZ)) throw Error("--near must be a positive number of metres");
+      if (!(l->readyTimeout > 0.0) || !std::isfinite(l->readyTimeout)) throw Error("--ready-timeout must be a positive number of seconds");
+      std::unique_ptr<RenderSetup> setup = setUpRender(*a);
+      LoopSetup ls;
+      ls.backend = setup->backend;
+      ls.scene = &setup->scene;
+      ls.rig = setup->rig;
+      ls.options = setup->options;
+      ls.trajectory = setup->trajectory;
+      return cmd == xr ? runXrCommand(*l, ls) : runViewCommand(*l, ls);
+    }
     if (bench->parsed()) {
       if (fa.suite == "maps") return runMapBench(ba);
       fa.scene = ba.scene;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <thread>
 #include <vector>
@@ -162,11 +163,14 @@ struct XrPresenter::Impl {
 XrPresenter::XrPresenter(const XrPresenterOptions& options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.options = options;
+  // The loader logs every failure to stderr on its own; photonvr reports the cause in one line.
+  // XR_LOADER_DEBUG=error (or all) brings the loader's log back.
+  setenv("XR_LOADER_DEBUG", "none", 0);
   uint32_t count = 0;
   XrResult r = xrEnumerateInstanceExtensionProperties(nullptr, 0, &count, nullptr);
   if (XR_FAILED(r))
     throw Error(std::string("no OpenXR runtime (") + xrResultName(r) +
-                "): start one (SteamVR, Monado, Meta's) or point XR_RUNTIME_JSON at a runtime's manifest");
+                "): start one (SteamVR, Monado, Meta's) or point XR_RUNTIME_JSON at a runtime's manifest (XR_LOADER_DEBUG=error shows the loader's log)");
   std::vector<XrExtensionProperties> available(count, {XR_TYPE_EXTENSION_PROPERTIES});
   xrCheck(xrEnumerateInstanceExtensionProperties(nullptr, count, &count, available.data()), "xrEnumerateInstanceExtensionProperties");
   if (!hasExtension(available, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME))

@@ -1,0 +1,47 @@
+#pragma once
+// The commands that run the frame loop: `xr` (an OpenXR headset, or --offscreen without one) and
+// `view` (the desktop viewer). The command line has made the scene, rig and options already.
+#include <string>
+#include <vector>
+
+#include "pvr/app/trajectory.h"
+#include "pvr/render/renderer.h"
+#include "pvr/scene/scene.h"
+
+namespace pvr {
+
+struct LoopCommandArgs {
+  uint64_t frames = 0;           ///< 0: until the session / window ends (xr: Ctrl-C)
+  uint64_t warmup = 0;
+  std::string stats = "out/xr_stats.json";
+  bool offscreen = false;        ///< xr: no runtime; views from --trajectory or the scene's head
+  std::string handOver = "vulkan";  ///< offscreen: vulkan (into Vulkan images, timed) | none
+  double refreshHz = 90.0;       ///< offscreen display slot
+  bool paced = false;            ///< offscreen: wait for each slot as vsync would
+  bool stage = false;            ///< xr: STAGE reference space
+  bool depthLayer = true;
+  float nearZ = 0.05f;
+  double readyTimeout = 10.0;
+  bool eyeSizeGiven = false;     ///< xr: --eye-size overrides the runtime's recommended size
+  float exposure = 1.0f;
+  // view
+  std::string screenshot = "out/view";
+  std::string keys;
+  bool noPanel = false;
+  std::string sceneName;         ///< as given, for the settings file
+  std::string acuity = "linear";
+};
+
+struct LoopSetup {
+  BackendKind backend = BackendKind::Auto;
+  const Scene* scene = nullptr;
+  StereoRig rig;
+  RenderOptions options;         ///< foveation.mask points at a mask the caller keeps
+  std::vector<TrajectoryFrame> trajectory;
+  std::string photons, radius;   ///< as given (for the log)
+};
+
+int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup);
+int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup);
+
+}  // namespace pvr

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The desktop viewer under Xvfb on the CPU backend: it opens, renders the Cornell box, writes a
+# screenshot on a scripted F12 and exits on a scripted Escape. What each eye shows is read back
+# from its Vulkan image; it must be byte for byte the PNG that `render` writes from the settings
+# file the viewer wrote (same pose, same options).
+set -u
+exe=$1
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+command -v xvfb-run >/dev/null || fail "xvfb-run is not installed (package xvfb)"
+timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$exe" view --backend cpu --eye-size 64x72 --photons 64x64 \
+  --keys 2:F12,4:Escape --screenshot "$out/shot" >"$out/log" 2>&1
+rc=$?
+cat "$out/log"
+[ $rc -eq 0 ] || fail "viewer exit code $rc"
+for f in shot_left.png shot_right.png shot.json shot_window.png; do [ -s "$out/$f" ] || fail "no $f written"; done
+grep -q '"scene": "cornell"' "$out/shot.json" || fail "settings file lacks the scene"
+"$exe" render --settings "$out/shot.json" --out "$out/render" >"$out/render.log" 2>&1 || fail "render --settings failed: $(cat "$out/render.log")"
+cmp "$out/render_left.png" "$out/shot_left.png" || fail "left eye differs from render's image"
+cmp "$out/render_right.png" "$out/shot_right.png" || fail "right eye differs from render's image"
+echo "viewer ok: both eyes match render's PNGs byte for byte"
