@@ -102,6 +102,7 @@ expect_error "unknown key" view --backend cpu --keys 3:F13
 expect_error "--handover must be" xr --offscreen --backend cpu --eye-size 8x8 --photons 16x16 --frames 1 --handover pcie --stats ""
 expect_error "refresh rate" xr --offscreen --backend cpu --eye-size 8x8 --photons 16x16 --frames 1 --refresh 0 --stats ""
 VK_DRIVER_FILES="$out/none.json" VK_ICD_FILENAMES="$out/none.json" expect_error "no Vulkan driver" xr --offscreen --backend cpu --eye-size 8x8 --photons 16x16 --frames 1 --stats ""
+expect_error "--cuda-copy must be" xr --offscreen --backend cpu --cuda-copy dma --frames 1
 expect_error "--near must be" xr --offscreen --backend cpu --near -1 --frames 1
 expect_error "--ready-timeout must be" xr --backend cpu --ready-timeout 0 --frames 1
 expect_error "cannot read settings file" render --settings "$out/none.json" "${small[@]}"

@@ -482,6 +482,10 @@ int runCli(int argc, char** argv) {
   xr->add_option("--handover", xl.handOver, "Offscreen: vulkan (hand the eyes to Vulkan images, timed) | none")->capture_default_str();
   xr->add_option("--refresh", xl.refreshHz, "Offscreen: display refresh rate in Hz (a frame later than its slot misses)")
       ->capture_default_str();
+  xr->add_option("--cuda-copy", xl.cudaCopy,
+                 "CUDA hand-over into the swapchain: buffer (a shared buffer, buffer-to-image copy) | image (a shared image, "
+                 "image-to-image copy)")
+      ->capture_default_str();
   xr->add_flag("--paced", xl.paced, "Offscreen: wait for each display slot as vsync would");
   xr->add_flag("--stage", xl.stage, "STAGE reference space (floor origin) instead of LOCAL (the head at start)");
   xr->add_flag("!--no-depth", xl.depthLayer, "Do not submit a depth layer");
@@ -553,6 +557,7 @@ int runCli(int argc, char** argv) {
       l->exposure = a->exposure;
       l->sceneName = a->scene;
       l->acuity = a->acuity;
+      if (l->cudaCopy != "buffer" && l->cudaCopy != "image") throw Error("--cuda-copy must be buffer or image, got '" + l->cudaCopy + "'");
       if (!(l->nearZ > 0.0f) || !std::isfinite(l->nearZ)) throw Error("--near must be a positive number of metres");
       if (!(l->readyTimeout > 0.0) || !std::isfinite(l->readyTimeout)) throw Error("--ready-timeout must be a positive number of seconds");
       std::unique_ptr<RenderSetup> setup = setUpRender(*a);

@@ -97,7 +97,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::unique_ptr<VulkanContext> vk;
     std::unique_ptr<EyeTransfer> transfer;
     VulkanImage colour[2], depth[2];
-    std::vector<double> handOverGpu, handOverEncode, handOverCopy;
+    std::vector<double> handOverGpu, handOverEncode, handOverCopy, handOverLatency;
     OffscreenOptions oo;
     oo.refreshHz = args.refreshHz;
     oo.paced = args.paced;
@@ -113,6 +113,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
       to.nearZ = args.nearZ;
       to.exposure = args.exposure;
       to.path = renderer.backendName() == "cuda" && vk->canShareWithCuda() ? HandOverPath::CudaShared : HandOverPath::HostStaging;
+      to.colourViaImage = args.cudaCopy == "image";
       transfer = std::make_unique<EyeTransfer>(*vk, to);
       for (int e = 0; e < 2; ++e) {
         colour[e] = makeImage(*vk, to.width, to.height, VK_FORMAT_R8G8B8A8_SRGB, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
@@ -137,15 +138,17 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
           targets[e] = {colour[e].image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, depth[e].image,
                         VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
         }
+        auto start = LoopClock::now();
         transfer->handOver(sources, targets);
         HandOverTiming t = transfer->lastTiming();  // waits: the hand-over is timed end to end
+        handOverLatency.push_back(std::chrono::duration<double, std::milli>(LoopClock::now() - start).count());
         double encode = f.onDevice ? t.encodeMs : t.hostEncodeMs;
         handOverEncode.push_back(encode);
         handOverCopy.push_back(t.copyMs);
         handOverGpu.push_back(encode + t.copyMs);
       };
       run["vulkan_device"] = vk->deviceName();
-      run["handover"] = handOverPathName(to.path);
+      run["handover"] = transfer->describe();
     } else if (args.handOver != "none") {
       throw Error("--handover must be vulkan or none, got '" + args.handOver + "'");
     } else {
@@ -164,8 +167,13 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
       run["handover_ms"] = skipWarmup(handOverGpu);
       run["handover_encode_ms"] = skipWarmup(handOverEncode);
       run["handover_copy_ms"] = skipWarmup(handOverCopy);
-      LatencyStats h = skipWarmup(handOverGpu);
-      std::printf("  hand-over (encode + copy, GPU)   mean %8.3f  p50 %8.3f  p99 %8.3f  max %8.3f ms\n", h.mean, h.p50, h.p99, h.max);
+      run["handover_latency_ms"] = skipWarmup(handOverLatency);
+      const char* names[3] = {"hand-over encode (kernel/host)", "hand-over copy (Vulkan queue)", "hand-over, start to copy done"};
+      const std::vector<double>* series[3] = {&handOverEncode, &handOverCopy, &handOverLatency};
+      for (int i = 0; i < 3; ++i) {
+        LatencyStats h = skipWarmup(*series[i]);
+        std::printf("  %-30s mean %8.3f  p50 %8.3f  p99 %8.3f  max %8.3f ms\n", names[i], h.mean, h.p50, h.p99, h.max);
+      }
     }
     run["presenter"] = "offscreen";
     run["refresh_hz"] = args.refreshHz;
@@ -181,6 +189,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     xo.exposure = args.exposure;
     xo.gpuImages = renderer.backendName() == "cuda";
     xo.readyTimeoutSeconds = args.readyTimeout;
+    xo.colourViaImage = args.cudaCopy == "image";
     XrPresenter presenter(xo);
     const XrSessionInfo& info = presenter.info();
     renderer.rig().width = info.eyeWidth, renderer.rig().height = info.eyeHeight;

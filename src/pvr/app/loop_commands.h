@@ -17,6 +17,7 @@ struct LoopCommandArgs {
   bool offscreen = false;        ///< xr: no runtime; views from --trajectory or the scene's head
   std::string handOver = "vulkan";  ///< offscreen: vulkan (into Vulkan images, timed) | none
   double refreshHz = 90.0;       ///< offscreen display slot
+  std::string cudaCopy = "buffer";  ///< CUDA hand-over: buffer (buffer-to-image copy) | image (image-to-image)
   bool paced = false;            ///< offscreen: wait for each slot as vsync would
   bool stage = false;            ///< xr: STAGE reference space
   bool depthLayer = true;

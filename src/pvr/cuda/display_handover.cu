@@ -17,7 +17,78 @@ __global__ void encodeEyeKernel(const Vec3* image, const float* inverseDepth, si
   if (depth && inverseDepth) depth[i] = reversedDepth(inverseDepth[i], nearZ);
 }
 
+__global__ void encodeEyeSurfaceKernel(const Vec3* image, const float* inverseDepth, int width, int height, float exposure,
+                                       DisplayEncoding encoding, float nearZ, cudaSurfaceObject_t surface, float* depth) {
+  int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x >= width || y >= height) return;
+  size_t i = size_t(y) * width + x;
+  unsigned char texel[8];
+  encodeDisplayPixel(image[i], exposure, encoding, texel);
+  if (displayBytesPerPixel(encoding) == 8) {
+    uint2 v;
+    memcpy(&v, texel, 8);
+    surf2Dwrite(v, surface, x * 8, y);
+  } else {
+    uint32_t v;
+    memcpy(&v, texel, 4);
+    surf2Dwrite(v, surface, x * 4, y);
+  }
+  if (depth && inverseDepth) depth[i] = reversedDepth(inverseDepth[i], nearZ);
+}
+
 }  // namespace
+
+SharedSurface::SharedSurface(int fd, size_t allocationBytes, int width, int height, int bytesPerPixel) {
+  cudaExternalMemoryHandleDesc desc{};
+  desc.type = cudaExternalMemoryHandleTypeOpaqueFd;
+  desc.handle.fd = fd;
+  desc.size = allocationBytes;
+  desc.flags = cudaExternalMemoryDedicated;
+  cudaExternalMemory_t memory;
+  cudaError_t status = cudaImportExternalMemory(&memory, &desc);
+  if (status != cudaSuccess) {
+    close(fd);
+    throwCudaError(status, "importing a Vulkan image (cudaImportExternalMemory)", __FILE__, __LINE__);
+  }
+  memory_ = memory;
+  cudaExternalMemoryMipmappedArrayDesc arrayDesc{};
+  arrayDesc.offset = 0;
+  arrayDesc.formatDesc = bytesPerPixel == 8 ? cudaCreateChannelDesc(16, 16, 16, 16, cudaChannelFormatKindFloat)
+                                            : cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned);
+  arrayDesc.extent = make_cudaExtent(size_t(width), size_t(height), 0);
+  arrayDesc.flags = cudaArraySurfaceLoadStore;
+  arrayDesc.numLevels = 1;
+  cudaMipmappedArray_t mipmapped;
+  status = cudaExternalMemoryGetMappedMipmappedArray(&mipmapped, memory, &arrayDesc);
+  if (status != cudaSuccess) {
+    cudaDestroyExternalMemory(memory);
+    memory_ = nullptr;
+    throwCudaError(status, "mapping a Vulkan image (cudaExternalMemoryGetMappedMipmappedArray)", __FILE__, __LINE__);
+  }
+  mipmapped_ = mipmapped;
+  cudaArray_t level;
+  cudaResourceDesc resource{};
+  status = cudaGetMipmappedArrayLevel(&level, mipmapped, 0);
+  if (status == cudaSuccess) {
+    resource.resType = cudaResourceTypeArray;
+    resource.res.array.array = level;
+    cudaSurfaceObject_t surface = 0;
+    status = cudaCreateSurfaceObject(&surface, &resource);
+    surface_ = surface;
+  }
+  if (status != cudaSuccess) {
+    cudaFreeMipmappedArray(mipmapped);
+    cudaDestroyExternalMemory(memory);
+    mipmapped_ = memory_ = nullptr;
+    throwCudaError(status, "a surface on a Vulkan image (cudaCreateSurfaceObject)", __FILE__, __LINE__);
+  }
+}
+
+SharedSurface::~SharedSurface() {
+  if (surface_) cudaDestroySurfaceObject(surface_);
+  if (mipmapped_) cudaFreeMipmappedArray(static_cast<cudaMipmappedArray_t>(mipmapped_));
+  if (memory_) cudaDestroyExternalMemory(static_cast<cudaExternalMemory_t>(memory_));
+}
 
 bool currentDeviceUuid(uint8_t uuid[16]) {
   int device = 0;
@@ -113,6 +184,15 @@ void encodeEyeForDisplay(const Vec3* image, const float* inverseDepth, size_t pi
   launch("display hand-over encode", encodeEyeKernel, dim3(unsigned((pixels + block - 1) / block)), dim3(block), 0,
          static_cast<cudaStream_t>(stream), image, inverseDepth, pixels, exposure, encoding, nearZ,
          static_cast<unsigned char*>(colour), depth);
+}
+
+void encodeEyeToSurface(const Vec3* image, const float* inverseDepth, int width, int height, float exposure,
+                        DisplayEncoding encoding, float nearZ, unsigned long long surface, float* depth, void* stream) {
+  if (width <= 0 || height <= 0) return;
+  dim3 block(32, 8);
+  dim3 grid(unsigned((width + 31) / 32), unsigned((height + 7) / 8));
+  launch("display hand-over encode (image)", encodeEyeSurfaceKernel, grid, block, 0, static_cast<cudaStream_t>(stream), image,
+         inverseDepth, width, height, exposure, encoding, nearZ, cudaSurfaceObject_t(surface), depth);
 }
 
 }  // namespace pvr::cuda

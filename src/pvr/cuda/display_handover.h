@@ -28,6 +28,22 @@ class SharedBuffer {
   void* data_ = nullptr;
 };
 
+// A Vulkan image (optimal tiling, one level) mapped into CUDA as a surface it writes texels to.
+// Takes ownership of `fd`. bytesPerPixel 4 (8-bit RGBA) or 8 (half RGBA).
+class SharedSurface {
+ public:
+  SharedSurface(int fd, size_t allocationBytes, int width, int height, int bytesPerPixel);
+  ~SharedSurface();
+  SharedSurface(const SharedSurface&) = delete;
+  SharedSurface& operator=(const SharedSurface&) = delete;
+  unsigned long long surface() const { return surface_; }  // cudaSurfaceObject_t
+
+ private:
+  void* memory_ = nullptr;     // cudaExternalMemory_t
+  void* mipmapped_ = nullptr;  // cudaMipmappedArray_t
+  unsigned long long surface_ = 0;
+};
+
 // A Vulkan (binary) semaphore that CUDA signals when its work on a stream is done.
 class SharedSemaphore {
  public:
@@ -63,5 +79,9 @@ class HandOverStream {
 // given, 1 / view depth into reversed-Z depth floats at `depth`. Asynchronous on `stream`.
 void encodeEyeForDisplay(const Vec3* image, const float* inverseDepth, size_t pixels, float exposure,
                          DisplayEncoding encoding, float nearZ, void* colour, float* depth, void* stream);
+
+// As encodeEyeForDisplay, the colour written as texels of a shared image's surface.
+void encodeEyeToSurface(const Vec3* image, const float* inverseDepth, int width, int height, float exposure,
+                        DisplayEncoding encoding, float nearZ, unsigned long long surface, float* depth, void* stream);
 
 }  // namespace pvr::cuda

@@ -49,7 +49,7 @@ std::vector<ScriptedKey> parseKeyScript(const std::string& text) {
 
 namespace {
 
-constexpr int kPanelWidth = 340;
+constexpr int kPanelWidth = 420;
 constexpr size_t kPlotFrames = 240;
 
 const char* const kKernels[] = {"single", "hybrid", "shared", "sorted"};
@@ -226,10 +226,11 @@ struct ViewerPresenter::Impl {
       ImGui::SetNextWindowPos(ImVec2(float(extent.width) - kPanelWidth, 0));
       ImGui::SetNextWindowSize(ImVec2(kPanelWidth, float(extent.height)));
       ImGui::Begin("photonvr", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+      ImGui::PushItemWidth(230);
       if (frame && frame->result) {
         const StageTimings& t = frame->result->timings;
-        ImGui::Text("%s: %.2f ms (trace %.2f, map %.2f, eyes %.2f + %.2f)", frame->renderer.backendName().c_str(),
-                    t.totalMs(), t.photonTraceMs, t.mapBuildMs, t.eyeMs[0], t.eyeMs[1]);
+        ImGui::Text("%s, %s", frame->renderer.backendName().c_str(), frame->renderer.deviceName().c_str());
+        ImGui::Text("%.2f ms: trace %.2f, map %.2f, eyes %.2f + %.2f", t.totalMs(), t.photonTraceMs, t.mapBuildMs, t.eyeMs[0], t.eyeMs[1]);
       }
       static const char* plotNames[] = {"frame", "photon trace", "map build", "left eye", "right eye"};
       for (int p = 0; p < 5; ++p)
@@ -257,6 +258,7 @@ struct ViewerPresenter::Impl {
       ImGui::Separator();
       ImGui::TextWrapped("Right-drag: look. WASD/QE: move. Cursor: gaze. F12: screenshot + settings. R: reset. Esc: quit.");
       for (const std::string& w : written) ImGui::TextWrapped("wrote %s", w.c_str());
+      ImGui::PopItemWidth();
       ImGui::End();
     }
     ImGui::Render();

@@ -7,6 +7,7 @@
 // a shared semaphore: no host round trip. Buffers are double-buffered; a slot is reused only once
 // the GPU finished its previous copy.
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "pvr/image/display_encoding.h"
@@ -45,6 +46,7 @@ struct EyeTransferOptions {
   float nearZ = 0.05f;                  ///< metres of depth 1 (display_encoding.h)
   float exposure = 1.0f;
   HandOverPath path = HandOverPath::HostStaging;
+  bool colourViaImage = false;          ///< CudaShared: colour through a shared image, not a buffer
 };
 
 struct HandOverTiming {
@@ -72,6 +74,7 @@ class EyeTransfer {
   void waitIdle();
   const EyeTransferOptions& options() const { return options_; }
   void setExposure(float exposure) { options_.exposure = exposure; }
+  std::string describe() const;  ///< the path, and on CUDA whether colour goes through an image or a buffer
 
  private:
   struct Slot;
@@ -85,6 +88,7 @@ class EyeTransfer {
   struct CudaState;
   std::unique_ptr<CudaState> cuda_;
   double lastHostEncodeMs_ = 0;
+  bool sharedImages_ = false;
 };
 
 }  // namespace pvr

@@ -286,6 +286,7 @@ VulkanImage& VulkanImage::operator=(VulkanImage&& o) noexcept {
   std::swap(format, o.format);
   std::swap(width, o.width);
   std::swap(height, o.height);
+  std::swap(allocationSize, o.allocationSize);
   return *this;
 }
 
@@ -295,7 +296,9 @@ VulkanImage::~VulkanImage() {
   if (memory) vkFreeMemory(device, memory, nullptr);
 }
 
-VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage) {
+namespace {
+
+VulkanImage createImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage, bool exportable) {
   VulkanImage img;
   img.device = vk.device();
   img.format = format;
@@ -310,15 +313,36 @@ VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat f
   ici.tiling = VK_IMAGE_TILING_OPTIMAL;
   ici.usage = usage;
   ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkExternalMemoryImageCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_IMAGE_CREATE_INFO};
+  external.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  if (exportable) ici.pNext = &external;
   vkCheck(vkCreateImage(img.device, &ici, nullptr, &img.image), "vkCreateImage");
   VkMemoryRequirements req;
   vkGetImageMemoryRequirements(img.device, img.image, &req);
+  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
+  dedicated.image = img.image;
+  VkExportMemoryAllocateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO};
+  exportInfo.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  exportInfo.pNext = &dedicated;
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  if (exportable) mai.pNext = &exportInfo;
   mai.allocationSize = req.size;
+  img.allocationSize = req.size;
   mai.memoryTypeIndex = vk.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   vkCheck(vkAllocateMemory(img.device, &mai, nullptr, &img.memory), "vkAllocateMemory (image)");
   vkCheck(vkBindImageMemory(img.device, img.image, img.memory, 0), "vkBindImageMemory");
   return img;
+}
+
+}  // namespace
+
+VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage) {
+  return createImage(vk, width, height, format, usage, false);
+}
+
+VulkanImage makeExportableImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage) {
+  if (!vk.canShareWithCuda()) throw Error("the Vulkan device '" + vk.deviceName() + "' cannot share memory with CUDA");
+  return createImage(vk, width, height, format, usage, true);
 }
 
 void transitionImage(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to) {

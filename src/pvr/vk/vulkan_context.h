@@ -99,12 +99,15 @@ struct VulkanImage {
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
   int width = 0, height = 0;
+  VkDeviceSize allocationSize = 0;
   VulkanImage() = default;
   VulkanImage(VulkanImage&& other) noexcept { *this = std::move(other); }
   VulkanImage& operator=(VulkanImage&& other) noexcept;
   ~VulkanImage();
 };
 VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage);
+// Device-local, optimal tiling, exportable as an opaque file descriptor (CUDA maps it as an array).
+VulkanImage makeExportableImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage);
 
 // Layout transition of a whole colour or depth image (all commands before, all after).
 void transitionImage(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to);

@@ -363,8 +363,9 @@ XrPresenter::XrPresenter(const XrPresenterOptions& options) : impl_(std::make_un
   to.nearZ = options.nearZ;
   to.exposure = options.exposure;
   to.path = path;
+  to.colourViaImage = options.colourViaImage;
   m.transfer = std::make_unique<EyeTransfer>(*m.vulkan, to);
-  info_.handOver = handOverPathName(path);
+  info_.handOver = m.transfer->describe();
 
   if (info_.eyeTracker) {  // the gaze pose action of XR_EXT_eye_gaze_interaction
     XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};

@@ -24,6 +24,7 @@ struct XrPresenterOptions {
   bool verge = true;
   float exposure = 1.0f;
   bool gpuImages = false;            ///< the renderer is CUDA: hand over device buffers (no host copy)
+  bool colourViaImage = false;       ///< CUDA hand-over through a shared image (else a shared buffer)
   double readyTimeoutSeconds = 10;   ///< the session must become READY within this
   double stopTimeoutSeconds = 5;     ///< after a stop request, the runtime must end the session within this
 };
