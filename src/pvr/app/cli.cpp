@@ -468,6 +468,8 @@ int runCli(int argc, char** argv) {
     cmd->add_option("--exposure", a->exposure, "Scale applied before display encoding")->capture_default_str();
     cmd->add_flag("--foveated", a->foveated, "Foveated rendering around the gaze");
     cmd->add_option("--acuity", a->acuity, "Acuity model of the foveation mask: linear | geisler-perry")->capture_default_str();
+    cmd->add_option("--mask", a->mask, "Foveation mask file from `photonvr mask` (default: made for the eye size)");
+    cmd->add_option("--shading", a->shading, "full | photons (the photon map alone)")->capture_default_str();
     cmd->add_option("--gaze", a->gaze, "Gaze X,Y (image fractions) when no eye tracker gives one")->capture_default_str();
     cmd->add_flag("--taa", a->taa, "Temporal anti-aliasing across the loop's frames");
     cmd->add_option("--taa-blend", a->taaBlend, "Weight of the current frame under --taa, in (0, 1]");

@@ -72,6 +72,7 @@ nlohmann::json describeRun(const Renderer& renderer, const LoopSetup& setup, con
 void refitMask(RenderOptions& options, const StereoRig& rig, const StereoRig& madeFor, const std::string& acuity,
                std::optional<FoveationMask>& mask) {
   if (!options.foveation.mask || (rig.width == madeFor.width && rig.height == madeFor.height)) return;
+  std::fprintf(stderr, "photonvr: note: foveation mask made for the headset's %dx%d eyes\n", rig.width, rig.height);
   MaskParams params = maskParamsForRig(rig);
   if (acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
   mask = generateFoveationMask(params);
@@ -193,7 +194,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     XrPresenter presenter(xo);
     const XrSessionInfo& info = presenter.info();
     renderer.rig().width = info.eyeWidth, renderer.rig().height = info.eyeHeight;
-    refitMask(renderer.options(), renderer.rig(), setup.rig, "linear", mask);
+    refitMask(renderer.options(), renderer.rig(), setup.rig, args.acuity, mask);
     std::printf("xr: %s, system '%s', Vulkan device %s\n", info.runtime.c_str(), info.system.c_str(), info.vulkanDevice.c_str());
     std::printf("  eyes %dx%d (runtime recommends %dx%d, at most %dx%d), swapchain %s, depth layer %s, eye tracker %s\n",
                 info.eyeWidth, info.eyeHeight, info.recommendedWidth, info.recommendedHeight, info.maxWidth, info.maxHeight,

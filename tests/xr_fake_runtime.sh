@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# photonvr xr against the test runtime (tests/fake_xr_runtime) on this machine's Vulkan device
+# (lavapipe in CI): a whole session whose frames are handed into the runtime's swapchain images,
+# and every OpenXR failure photonvr reports, each provoked by PVR_FAKE_XR: one line on stderr,
+# a non-zero exit, no hang.
+set -u
+exe=$1
+export XR_RUNTIME_JSON=$2
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+failures=0
+small=(--backend cpu --photons 16x16)
+
+PVR_FAKE_XR=ok timeout 120 "$exe" xr "${small[@]}" --frames 12 --stats "$out/ok.json" >"$out/ok.log" 2>"$out/ok.err"
+rc=$?
+flat=$(tr -d ' \n' <"$out/ok.json" 2>/dev/null)
+if [ $rc -ne 0 ] || [ -s "$out/ok.err" ] || ! grep -q '"final_state":"EXITING"' <<<"$flat" || ! grep -q '"frames":12,' <<<"$flat" ||
+   ! grep -q '"depth_layer":true' <<<"$flat" || ! grep -q '"eye_size":\[64,48\]' <<<"$flat"; then
+  echo "FAIL (a session): exit $rc, stderr: $(cat "$out/ok.err")"
+  cat "$out/ok.log"
+  failures=$((failures + 1))
+else
+  echo "ok   (a session of 12 frames at the runtime's 64x48, depth layer, ended in EXITING)"
+fi
+
+expect_error() {  # mode, expected-substring, extra arguments...
+  local mode=$1 expected=$2
+  shift 2
+  PVR_FAKE_XR=$mode timeout 60 "$exe" xr "${small[@]}" --frames 20 --stats "" "$@" >"$out/stdout" 2>"$out/stderr"
+  local rc=$?
+  local lines
+  lines=$(wc -l <"$out/stderr")
+  if [ "$rc" -eq 0 ] || [ "$rc" -ge 124 ]; then
+    echo "FAIL ($mode): exit code $rc"
+    failures=$((failures + 1))
+  elif [ "$lines" -ne 1 ] || ! grep -qi -- "$expected" "$out/stderr"; then
+    echo "FAIL ($mode): expected one line with '$expected', got: $(cat "$out/stderr")"
+    failures=$((failures + 1))
+  else
+    echo "ok   ($mode): $(cat "$out/stderr")"
+  fi
+}
+
+expect_error noext "does not offer XR_KHR_vulkan_enable2"
+expect_error nohmd "no headset connected"
+expect_error binding "refused the Vulkan graphics binding"
+expect_error formats "offers no colour swapchain format"
+expect_error noready "did not become ready within 1 s" --ready-timeout 1
+expect_error lost "session was lost"
+expect_error norelease "did not release a swapchain image"
+
+[ "$failures" -eq 0 ] && echo "all OpenXR cases passed" || echo "$failures OpenXR case(s) failed"
+exit $((failures > 0))
