@@ -61,6 +61,7 @@ TEST(GpuHandOver, CudaImagesArriveInVulkanWithoutTheHost) {
       });
       source[e].deviceImage = renderer.deviceImage(Eye(e));
       source[e].deviceInverseDepth = renderer.deviceInverseDepth(Eye(e));
+      source[e].deviceStream = renderer.deviceStream();
       ASSERT_NE(source[e].deviceImage, nullptr);
       target[e] = {colour[e].image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, depth[e].image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
     }

@@ -6,6 +6,7 @@
 // primitive ids follow Embree's convention, so both backends report the same hits.
 #include "pvr/accel/bvh.h"
 #include "pvr/geometry/ray.h"
+#include "pvr/shading/scene_view.h"
 
 namespace pvr {
 
@@ -69,6 +70,9 @@ PVR_HOST_DEVICE inline bool intersectTriangleWatertight(const WatertightRay& r, 
 
 struct BvhIntersector {
   BvhView bvh;
+  // Alpha masking (any-hit): with alphaTest, hits on texels a material cuts out are skipped.
+  bool alphaTest = false;
+  SceneView alphaScene;
 
   static constexpr int kStackSize = 64;
 
@@ -145,6 +149,7 @@ struct BvhIntersector {
             loadTriangle(tri + i, v0, v1, v2, prim);
             float t, u, v;
             if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
+              if (alphaTest && !alphaScene.alphaPasses(prim, u, v)) continue;
               if (AnyHit) return true;
               tMax = t;
               hit.t = t, hit.u = u, hit.v = v, hit.primId = prim;

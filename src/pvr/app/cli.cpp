@@ -555,7 +555,9 @@ int runCli(int argc, char** argv) {
       if (!cmd->parsed()) continue;
       if (!a->settings.empty()) applySettings(a->settings, *a, *cmd);
       if (cmd == view && a->eyeSize.empty()) a->eyeSize = "640x712";
-      l->eyeSizeGiven = !a->eyeSize.empty();
+      // xr: the runtime's recommended size unless --eye-size is on this command line (a settings
+      // file from the viewer holds the viewer's size).
+      l->eyeSizeGiven = cmd == xr ? cmd->count("--eye-size") > 0 : !a->eyeSize.empty();
       l->exposure = a->exposure;
       l->sceneName = a->scene;
       l->acuity = a->acuity;

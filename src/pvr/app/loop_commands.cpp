@@ -132,6 +132,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
           if (f.onDevice) {
             sources[e].deviceImage = f.renderer.deviceImage(Eye(e));
             sources[e].deviceInverseDepth = f.renderer.deviceInverseDepth(Eye(e));
+            sources[e].deviceStream = f.renderer.deviceStream();
           } else {
             sources[e].image = &f.result->eyes[e].image;
             sources[e].inverseDepth = &f.result->eyes[e].inverseDepth;
@@ -190,6 +191,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     xo.exposure = args.exposure;
     xo.gpuImages = renderer.backendName() == "cuda";
     xo.readyTimeoutSeconds = args.readyTimeout;
+    xo.stop = &gStop;
     xo.colourViaImage = args.cudaCopy == "image";
     XrPresenter presenter(xo);
     const XrSessionInfo& info = presenter.info();
@@ -285,14 +287,16 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
   FrameLoopOptions lo;
   lo.maxFrames = args.frames;
   lo.stop = &gStop;
+  RenderOptions current = setup.options;  // the panel's changes survive a change of backend
   for (;;) {
     Renderer renderer(*setup.scene, kind);
     renderer.rig() = setup.rig;
-    renderer.options() = setup.options;
+    renderer.options() = current;
     std::printf("view: %s backend (%s), eyes %dx%d\n", renderer.backendName().c_str(), renderer.deviceName().c_str(),
                 setup.rig.width, setup.rig.height);
     FrameStats stats = FrameLoop(renderer, viewer).run(lo);
     std::printf("%s", stats.summary().c_str());
+    current = renderer.options();
     if (!viewer.backendChangeRequested()) break;
     viewer.clearBackendChange();
     kind = viewer.settings().backend ? BackendKind::Cuda : BackendKind::Cpu;

@@ -65,6 +65,10 @@ struct EyeCamera {
     return pose.toWorldPoint(localDirection(px, py) * (1.0f / inverseDepth));
   }
 
+  // The width of one pixel's footprint per unit distance along the view axis (a ray cone's
+  // spread for texture filtering).
+  PVR_HOST_DEVICE float pixelSpread() const { return (tanf(fov.angleUp) - tanf(fov.angleDown)) / float(height); }
+
   PVR_HOST_DEVICE bool containsPixel(float px, float py) const {
     return px >= 0.0f && py >= 0.0f && px < float(width) && py < float(height);
   }

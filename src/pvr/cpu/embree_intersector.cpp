@@ -6,6 +6,19 @@
 #include "pvr/util/error.h"
 
 namespace pvr {
+namespace {
+
+// Any-hit filter for alpha masking: a hit on a cut-out texel is rejected and the ray goes on.
+void alphaFilter(const RTCFilterFunctionNArguments* args) {
+  const SceneView* scene = static_cast<const SceneView*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    if (!scene->alphaPasses(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i))) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
 
 EmbreeIntersector::EmbreeIntersector(const Scene& scene) {
   device_ = rtcNewDevice(nullptr);
@@ -23,6 +36,12 @@ EmbreeIntersector::EmbreeIntersector(const Scene& scene) {
   if (!vb || !ib) throw Error("out of memory while building the Embree scene");
   std::memcpy(vb, vertices.data(), vertices.size() * sizeof(Vec3));
   std::memcpy(ib, indices.data(), indices.size() * sizeof(uint32_t));
+  if (scene.hasAlphaTestedMaterial()) {
+    alphaScene_ = scene.view();
+    rtcSetGeometryUserData(geom, &alphaScene_);
+    rtcSetGeometryIntersectFilterFunction(geom, alphaFilter);
+    rtcSetGeometryOccludedFilterFunction(geom, alphaFilter);
+  }
   rtcCommitGeometry(geom);
   rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);

@@ -60,6 +60,7 @@ class EmbreeIntersector {
   }
 
  private:
+  SceneView alphaScene_;  // alpha-tested scenes: the filter functions read the materials through it
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
 };

@@ -219,6 +219,7 @@ const Vec3* CudaFrameBackend::deviceImage(Eye eye, bool displayed) const {
 }
 
 const float* CudaFrameBackend::deviceInverseDepth(Eye eye) const { return impl_->eyePass.inverseDepth(eye); }
+void* CudaFrameBackend::deviceStream() const { return impl_->stream; }
 
 std::vector<Photon> CudaFrameBackend::tracePhotonsToHost(const PhotonTraceParams& params) {
   Impl& m = *impl_;

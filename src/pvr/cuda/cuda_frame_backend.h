@@ -47,6 +47,7 @@ class CudaFrameBackend : public FrameBackend {
   void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override;
   const Vec3* deviceImage(Eye eye, bool displayed) const override;
   const float* deviceInverseDepth(Eye eye) const override;
+  void* deviceStream() const override;
 
   // Tools for tests and benchmarks.
   std::vector<Photon> tracePhotonsToHost(const PhotonTraceParams& params);

@@ -1,5 +1,8 @@
 #include "pvr/cuda/device_scene.cuh"
 
+#include <algorithm>
+#include <vector>
+
 namespace pvr::cuda {
 
 void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
@@ -13,6 +16,21 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   materials.upload(scene.materials().data(), scene.materials().size(), "materials");
   lightTriangles.upload(host.lightTriangles, host.lightCount, "light triangles");
   lightCdf.upload(host.lightCdf, size_t(host.lightCount) + 1, "light CDF");
+  for (int set = 0; set < 2; ++set)
+    if (host.uvs[set]) uvs[set].upload(host.uvs[set], vertexCount, "texture coordinates");
+  // Textures: one texel buffer; the views' pointers rebased onto it.
+  std::vector<TextureView> deviceTextures(scene.textureViews());
+  size_t texelCount = 0;
+  for (uint32_t t = 0; t < scene.textureCount(); ++t) texelCount += scene.textureTexels(t).size();
+  texels.reserve(std::max<size_t>(texelCount, 1), "textures");
+  size_t offset = 0;
+  for (uint32_t t = 0; t < scene.textureCount(); ++t) {
+    const std::vector<uint32_t>& level = scene.textureTexels(t);
+    PVR_CUDA_CHECK(cudaMemcpy(texels.data() + offset, level.data(), level.size() * sizeof(uint32_t), cudaMemcpyHostToDevice));
+    deviceTextures[t].texels = texels.data() + offset;
+    offset += level.size();
+  }
+  if (!deviceTextures.empty()) textures.upload(deviceTextures.data(), deviceTextures.size(), "texture views");
   nodes.upload(bvh.nodes().data(), bvh.nodes().size(), "BVH nodes");
   triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
   PVR_CUDA_CHECK(cudaDeviceSynchronize());
@@ -25,6 +43,10 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   view.materials = materials.data();
   view.lightTriangles = lightTriangles.data();
   view.lightCdf = lightCdf.data();
+  for (int set = 0; set < 2; ++set) view.uvs[set] = host.uvs[set] ? uvs[set].data() : nullptr;
+  view.textures = deviceTextures.empty() ? nullptr : textures.data();
+  intersector.alphaTest = scene.hasAlphaTestedMaterial();
+  intersector.alphaScene = view;
   intersector.bvh = {nodes.data(), triangles.data(), uint32_t(bvh.nodes().size()), uint32_t(bvh.triangles().size())};
 }
 

@@ -11,6 +11,9 @@ namespace pvr::cuda {
 
 struct DeviceScene {
   DeviceBuffer<Vec3> vertices, normals, faceNormals;
+  DeviceBuffer<Vec2> uvs[2];
+  DeviceBuffer<uint32_t> texels;         ///< every texture's levels, one after the other
+  DeviceBuffer<TextureView> textures;    ///< pointing into `texels`
   DeviceBuffer<uint32_t> indices, materialIds, lightTriangles;
   DeviceBuffer<Material> materials;
   DeviceBuffer<float> lightCdf;

@@ -14,7 +14,7 @@ __global__ void encodeEyeKernel(const Vec3* image, const float* inverseDepth, si
   size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= pixels) return;
   encodeDisplayPixel(image[i], exposure, encoding, colour + i * size_t(displayBytesPerPixel(encoding)));
-  if (depth && inverseDepth) depth[i] = reversedDepth(inverseDepth[i], nearZ);
+  if (depth) depth[i] = inverseDepth ? reversedDepth(inverseDepth[i], nearZ) : 0.0f;
 }
 
 __global__ void encodeEyeSurfaceKernel(const Vec3* image, const float* inverseDepth, int width, int height, float exposure,
@@ -33,7 +33,7 @@ __global__ void encodeEyeSurfaceKernel(const Vec3* image, const float* inverseDe
     memcpy(&v, texel, 4);
     surf2Dwrite(v, surface, x * 4, y);
   }
-  if (depth && inverseDepth) depth[i] = reversedDepth(inverseDepth[i], nearZ);
+  if (depth) depth[i] = inverseDepth ? reversedDepth(inverseDepth[i], nearZ) : 0.0f;
 }
 
 }  // namespace
@@ -152,29 +152,39 @@ void SharedSemaphore::signal(void* stream) {
   PVR_CUDA_CHECK(cudaSignalExternalSemaphoresAsync(&semaphore, &params, 1, static_cast<cudaStream_t>(stream)));
 }
 
-HandOverStream::HandOverStream() {
-  cudaStream_t s;
+HandOverEvents::HandOverEvents() {
   cudaEvent_t a, b;
-  PVR_CUDA_CHECK(cudaStreamCreateWithFlags(&s, cudaStreamNonBlocking));
   PVR_CUDA_CHECK(cudaEventCreate(&a));
   PVR_CUDA_CHECK(cudaEventCreate(&b));
-  stream_ = s, start_ = a, stop_ = b;
+  start_ = a, stop_ = b;
 }
 
-HandOverStream::~HandOverStream() {
+HandOverEvents::~HandOverEvents() {
   cudaEventDestroy(static_cast<cudaEvent_t>(start_));
   cudaEventDestroy(static_cast<cudaEvent_t>(stop_));
-  cudaStreamDestroy(static_cast<cudaStream_t>(stream_));
 }
 
-void HandOverStream::begin() { PVR_CUDA_CHECK(cudaEventRecord(static_cast<cudaEvent_t>(start_), static_cast<cudaStream_t>(stream_))); }
-void HandOverStream::end() { PVR_CUDA_CHECK(cudaEventRecord(static_cast<cudaEvent_t>(stop_), static_cast<cudaStream_t>(stream_))); }
+void HandOverEvents::begin(void* stream) {
+  PVR_CUDA_CHECK(cudaEventRecord(static_cast<cudaEvent_t>(start_), static_cast<cudaStream_t>(stream)));
+}
 
-double HandOverStream::lastMs() {
+void HandOverEvents::end(void* stream) {
+  PVR_CUDA_CHECK(cudaEventRecord(static_cast<cudaEvent_t>(stop_), static_cast<cudaStream_t>(stream)));
+  recorded_ = true;
+}
+
+double HandOverEvents::lastMs() {
+  if (!recorded_) return 0.0;
   float ms = 0;
   PVR_CUDA_CHECK(cudaEventSynchronize(static_cast<cudaEvent_t>(stop_)));
   PVR_CUDA_CHECK(cudaEventElapsedTime(&ms, static_cast<cudaEvent_t>(start_), static_cast<cudaEvent_t>(stop_)));
   return ms;
+}
+
+void synchronizeStream(void* stream) { PVR_CUDA_CHECK(cudaStreamSynchronize(static_cast<cudaStream_t>(stream))); }
+
+void synchronizeStreamQuietly(void* stream) noexcept {
+  if (cudaStreamSynchronize(static_cast<cudaStream_t>(stream)) != cudaSuccess) cudaGetLastError();
 }
 
 void encodeEyeForDisplay(const Vec3* image, const float* inverseDepth, size_t pixels, float exposure,

@@ -57,23 +57,27 @@ class SharedSemaphore {
   void* semaphore_ = nullptr;  // cudaExternalSemaphore_t
 };
 
-// One stream with timing events for the hand-over's encoding kernels.
-class HandOverStream {
+// Timing events around the hand-over's kernels, recorded on the stream they run on.
+class HandOverEvents {
  public:
-  HandOverStream();
-  ~HandOverStream();
-  HandOverStream(const HandOverStream&) = delete;
-  HandOverStream& operator=(const HandOverStream&) = delete;
-  void* stream() const { return stream_; }
-  void begin();             ///< records the start event
-  void end();               ///< records the end event
-  double lastMs();          ///< GPU time between the last begin and end (waits for end)
+  HandOverEvents();
+  ~HandOverEvents();
+  HandOverEvents(const HandOverEvents&) = delete;
+  HandOverEvents& operator=(const HandOverEvents&) = delete;
+  void begin(void* stream);  ///< cudaStream_t
+  void end(void* stream);
+  bool recorded() const { return recorded_; }
+  double lastMs();           ///< GPU time between the last begin and end (waits for end)
 
  private:
-  void* stream_ = nullptr;
   void* start_ = nullptr;
   void* stop_ = nullptr;
+  bool recorded_ = false;
 };
+
+// Waits for all work on a stream (cudaStream_t; null: the default stream).
+void synchronizeStream(void* stream);
+void synchronizeStreamQuietly(void* stream) noexcept;  ///< for destructors: errors are dropped
 
 // Encodes `pixels` of a linear image into `colour` (displayBytesPerPixel each) and, when both are
 // given, 1 / view depth into reversed-Z depth floats at `depth`. Asynchronous on `stream`.

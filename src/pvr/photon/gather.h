@@ -46,19 +46,23 @@ struct GatherPoint {
 };
 
 // Follows the eye ray through mirrors and glass to the first diffuse surface. `firstHit`, if
-// given, is the ray's first intersection, already traced.
+// given, is the ray's first intersection, already traced. `coneSpread` is the ray cone's width
+// per unit distance (a pixel's, for camera rays): it chooses the textures' level of detail, and
+// grows along the path (mirrors and glass are flat).
 template <class Intersector>
 PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Intersector& intersector,
                                            const GatherParams& params, Ray ray, CounterRng& rng,
-                                           const Hit* firstHit = nullptr) {
+                                           const Hit* firstHit = nullptr, float coneSpread = 0.0f) {
   GatherPoint out;
   Vec3 throughput{1, 1, 1};
   float eps = scene.rayEpsilon();
+  float coneWidth = 0.0f;
   for (int depth = 0; depth <= params.maxSpecularDepth; ++depth) {
     Hit hit;
     if (depth == 0 && firstHit) hit = *firstHit;
     else intersector.intersect(ray, INFINITY, hit);
     if (!hit.valid()) break;
+    coneWidth += coneSpread * hit.t;
     SurfacePoint sp = scene.surfacePoint(hit);
     const Material& m = scene.materials[sp.materialId];
     bool front = dot(ray.dir, sp.geometricNormal) < 0.0f;
@@ -66,7 +70,7 @@ PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Interse
     if (m.type == MaterialType::Diffuse) {
       Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
       Vec3 nShade = front ? sp.shadingNormal : -sp.shadingNormal;
-      Vec3 brdf = m.albedo * kInvPi;
+      Vec3 brdf = scene.albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo)) * kInvPi;
       if (params.mode == ShadingMode::Full && scene.lightCount > 0) {
         float uPick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
         LightSample ls = sampleLight(scene, uPick, u1, u2);
@@ -143,7 +147,7 @@ PVR_HOST_DEVICE GatherPoint imagePositionGatherPoint(const SceneView& scene, con
   Hit first;
   intersector.intersect(ray, INFINITY, first);
   inverseDepth = firstHitInverseDepth(camera, ray, first);
-  return traceToDiffuse(scene, intersector, params, ray, rng, &first);
+  return traceToDiffuse(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
 }
 
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
@@ -173,7 +177,7 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   }
   CounterRng rng(0, 0, 0);
   Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
-  if (s > 0) return traceToDiffuse(scene, intersector, params, ray, rng);
+  if (s > 0) return traceToDiffuse(scene, intersector, params, ray, rng, nullptr, camera.pixelSpread());
   Hit first;
   intersector.intersect(ray, INFINITY, first);
   pixel.firstPrim = first.primId;
@@ -186,7 +190,7 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
       return reused;
     }
   }
-  return traceToDiffuse(scene, intersector, params, ray, rng, &first);
+  return traceToDiffuse(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
 }
 
 // A foveation mask vertex at image position (px, py). On a pixel centre (all of the mask's

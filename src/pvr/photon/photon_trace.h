@@ -65,9 +65,10 @@ PVR_HOST_DEVICE int tracePhoton(const SceneView& scene, const Intersector& inter
         s.power = photon.power;
         s.direction = dir;
       }
-      float survive = fminf(1.0f, maxComponent(m.albedo));
+      Vec3 albedo = scene.albedoAt(m, hit.primId, hit.u, hit.v);
+      float survive = fminf(1.0f, maxComponent(albedo));
       if (!(rng.uniform() < survive)) break;
-      photon.power *= m.albedo * (1.0f / survive);
+      photon.power *= albedo * (1.0f / survive);
       // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
       float uTheta = rng.uniform();
       float uPhi = rng.uniform();

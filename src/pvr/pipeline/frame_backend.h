@@ -151,6 +151,9 @@ class FrameBackend {
   virtual const Vec3* deviceImage(Eye eye, bool displayed) const { return nullptr; }
   // The last frame's per-pixel 1 / view depth of an eye in GPU memory; null on the CPU.
   virtual const float* deviceInverseDepth(Eye eye) const { return nullptr; }
+  // The GPU stream the frame's work runs on (cudaStream_t); work queued on it after a frame runs
+  // before the next frame's. Null on the CPU.
+  virtual void* deviceStream() const { return nullptr; }
 };
 
 }  // namespace pvr

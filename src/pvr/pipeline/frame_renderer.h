@@ -29,6 +29,7 @@ class FrameRenderer {
   const Vec3* deviceImage(Eye eye) const;
   // The same frame's per-pixel 1 / view depth (0: nothing hit) in GPU memory; null as above.
   const float* deviceInverseDepth(Eye eye) const;
+  void* deviceStream() const { return backend_->deviceStream(); }  ///< cudaStream_t of the frames; null on the CPU
 
   std::string name() const { return backend_->name(); }  ///< "cpu" or "cuda"
   std::string deviceName() const { return backend_->deviceName(); }

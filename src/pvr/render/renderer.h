@@ -46,6 +46,9 @@ class Renderer {
   // rig's size), valid until the next frame; null on the CPU backend.
   const Vec3* deviceImage(Eye eye) const { return frames_.deviceImage(eye); }
   const float* deviceInverseDepth(Eye eye) const { return frames_.deviceInverseDepth(eye); }  ///< 1 / view depth, as above
+  // The GPU stream the frames run on (cudaStream_t): work queued on it after a frame (a hand-over
+  // reading deviceImage) finishes before the next frame writes the images again. Null on the CPU.
+  void* deviceStream() const { return frames_.deviceStream(); }
   const StereoRig& rig() const { return rig_; }
   const RenderOptions& options() const { return options_; }
   void resetHistory() { frames_.resetHistory(); }  ///< a cut: TAA starts again

@@ -15,7 +15,23 @@ uint32_t Scene::addMaterial(const Material& m, const std::string& materialName) 
 
 void Scene::addMesh(const std::string& meshName, const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
                     const std::vector<uint32_t>& indices, uint32_t materialId) {
+  static const std::vector<Vec2> none[2];
+  addMesh(meshName, vertices, normals, none, indices, materialId);
+}
+
+void Scene::addMesh(const std::string& meshName, const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
+                    const std::vector<Vec2> (&uvs)[2], const std::vector<uint32_t>& indices, uint32_t materialId) {
   if (materialId >= materials_.size()) throw Error("mesh '" + meshName + "' refers to a missing material");
+  for (int set = 0; set < 2; ++set) {  // sets missing on earlier meshes are zero for them
+    bool with = uvs[set].size() == vertices.size() && !vertices.empty();
+    if (with && uvs_[set].empty()) uvs_[set].assign(vertices_.size(), Vec2{});
+    if (with) {
+      for (Vec2 uv : uvs[set])
+        uvs_[set].push_back(std::isfinite(uv.x) && std::isfinite(uv.y) ? uv : Vec2{});
+    } else if (!uvs_[set].empty()) {
+      uvs_[set].resize(vertices_.size() + vertices.size(), Vec2{});
+    }
+  }
   bool withNormals = !normals.empty() && normals.size() == vertices.size();
   if (withNormals && normals_.empty()) normals_.assign(vertices_.size(), Vec3(0.0f));
   uint32_t base = uint32_t(vertices_.size());
@@ -53,6 +69,10 @@ void Scene::finalize() {
     Vec3 a = vertices_[indices_[3 * t]], b = vertices_[indices_[3 * t + 1]], c = vertices_[indices_[3 * t + 2]];
     faceNormals_[t] = normalize(cross(b - a, c - a));
   }
+  for (size_t i = 0; i < materials_.size(); ++i)
+    for (const TextureRef* ref : {&materials_[i].baseColorTexture, &materials_[i].opacityTexture})
+      if (ref->texture >= int32_t(textures_.size()))
+        throw Error("material '" + materialNames_[i] + "' refers to a missing texture");
   lightTriangles_.clear();
   lightCdf_.assign(1, 0.0f);
   SceneView v = view();
@@ -69,8 +89,64 @@ void Scene::finalize() {
   sceneRadius_ = std::max(0.5f * length(b.extent()), 1e-3f);
 }
 
+uint32_t Scene::addTexture(const std::string& textureName, int width, int height, std::vector<uint32_t> rgba, bool srgb,
+                           WrapMode wrapS, WrapMode wrapT) {
+  if (width <= 0 || height <= 0 || width > 32768 || height > 32768 || rgba.size() != size_t(width) * size_t(height))
+    throw Error("texture '" + textureName + "' has a bad size (" + std::to_string(width) + "x" + std::to_string(height) + ")");
+  TextureView t;
+  t.width = width, t.height = height;
+  t.wrapS = wrapS, t.wrapT = wrapT;
+  t.srgb = srgb;
+  std::vector<uint32_t> texels = std::move(rgba);
+  auto toLinear = [&](uint32_t code) { return srgb ? srgb8ToLinear(code) : float(code) / 255.0f; };
+  auto toCode = [&](float v) {
+    v = std::clamp(v, 0.0f, 1.0f);
+    if (srgb) v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    return uint32_t(std::lround(255.0f * v));
+  };
+  int w = width, h = height, level = 0;
+  t.levelOffset[0] = 0;
+  for (;;) {
+    ++level;
+    if ((w == 1 && h == 1) || level == kMaxTextureLevels) break;
+    // Each texel of the next level averages the 2x2 (or 2x1, 1x2) texels under it, in linear light.
+    int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
+    size_t src = t.levelOffset[level - 1];
+    t.levelOffset[level] = uint32_t(texels.size());
+    for (int y = 0; y < nh; ++y)
+      for (int x = 0; x < nw; ++x) {
+        float sum[4] = {0, 0, 0, 0};
+        int n = 0;
+        for (int dy = 0; dy < (h > 1 ? 2 : 1); ++dy)
+          for (int dx = 0; dx < (w > 1 ? 2 : 1); ++dx, ++n) {
+            uint32_t c = texels[src + size_t(std::min(2 * y + dy, h - 1)) * w + std::min(2 * x + dx, w - 1)];
+            for (int k = 0; k < 3; ++k) sum[k] += toLinear((c >> (8 * k)) & 255u);
+            sum[3] += float(c >> 24) / 255.0f;
+          }
+        uint32_t out = 0;
+        for (int k = 0; k < 3; ++k) out |= toCode(sum[k] / float(n)) << (8 * k);
+        out |= uint32_t(std::lround(255.0f * std::clamp(sum[3] / float(n), 0.0f, 1.0f))) << 24;
+        texels.push_back(out);
+      }
+    w = nw, h = nh;
+  }
+  t.levels = level;
+  textureTexels_.push_back(std::move(texels));
+  textures_.push_back(t);
+  for (size_t i = 0; i < textures_.size(); ++i) textures_[i].texels = textureTexels_[i].data();  // may have moved
+  return uint32_t(textures_.size() - 1);
+}
+
+bool Scene::hasAlphaTestedMaterial() const {
+  return std::any_of(materials_.begin(), materials_.end(), [](const Material& m) { return m.alphaTested(); });
+}
+
 SceneView Scene::view() const {
   SceneView v;
+  v.uvs[0] = uvs_[0].empty() ? nullptr : uvs_[0].data();
+  v.uvs[1] = uvs_[1].empty() ? nullptr : uvs_[1].data();
+  v.textures = textures_.empty() ? nullptr : textures_.data();
+  v.textureCount = uint32_t(textures_.size());
   v.vertices = vertices_.data();
   v.normals = normals_.empty() ? nullptr : normals_.data();
   v.faceNormals = faceNormals_.empty() ? nullptr : faceNormals_.data();

@@ -23,6 +23,20 @@ class Scene {
   // in skippedTriangles(). `normals` is empty or one per vertex.
   void addMesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
                const std::vector<uint32_t>& indices, uint32_t materialId);
+  // The same with texture coordinates: `uvs[set]` empty or one per vertex (sets 0 and 1).
+  void addMesh(const std::string& name, const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
+               const std::vector<Vec2> (&uvs)[2], const std::vector<uint32_t>& indices, uint32_t materialId);
+  // A texture from its level-0 RGBA8 texels (row 0 at the top, byte 0 = R); the mip chain is built
+  // here (box filter in linear light). Throws pvr::Error for a bad size. Returns its index for
+  // TextureRef::texture.
+  uint32_t addTexture(const std::string& name, int width, int height, std::vector<uint32_t> rgba, bool srgb,
+                      WrapMode wrapS = WrapMode::Repeat, WrapMode wrapT = WrapMode::Repeat);
+  uint32_t textureCount() const { return uint32_t(textures_.size()); }
+  bool hasAlphaTestedMaterial() const;  ///< some material cuts texels out (intersectors test alpha)
+  const std::vector<uint32_t>& textureTexels(uint32_t i) const { return textureTexels_[i]; }
+  const std::vector<TextureView>& textureViews() const { return textures_; }  ///< texels point into this scene
+  const std::vector<Vec2>& uvs(int set) const { return uvs_[set]; }
+  const std::vector<uint32_t>& materialIds() const { return materialIds_; }
   // Builds the light list; throws pvr::Error if nothing emits light or the scene is empty.
   void finalize();
 
@@ -50,8 +64,11 @@ class Scene {
   std::vector<Vec3> vertices_;
   std::vector<Vec3> normals_;  // empty if no mesh has normals
   std::vector<Vec3> faceNormals_;  // one per triangle, by winding (finalize)
+  std::vector<Vec2> uvs_[2];     // empty if no mesh has that set
   std::vector<uint32_t> indices_;
   std::vector<uint32_t> materialIds_;
+  std::vector<std::vector<uint32_t>> textureTexels_;
+  std::vector<TextureView> textures_;
   std::vector<Material> materials_;
   std::vector<std::string> materialNames_;
   std::vector<MeshRange> meshes_;

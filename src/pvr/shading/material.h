@@ -1,17 +1,30 @@
 #pragma once
 // Surface materials: Lambertian diffuse (where photons are stored), perfect mirror and smooth
-// dielectric (glass). Any material may also emit (an area light).
+// dielectric (glass). Any material may also emit (an area light). The colour may come from a
+// texture (times the constant factor), and an alpha mask may cut texels out of the surface.
 #include "pvr/math/vec.h"
+#include "pvr/shading/texture.h"
 
 namespace pvr {
 
 enum class MaterialType : uint32_t { Diffuse = 0, Mirror = 1, Glass = 2 };
+
+// glTF's alphaMode. BLEND is treated as MASK at the cutoff (a ray tracer's surfaces are opaque
+// or absent; stochastic transparency would be noisier, not more right): docs/scene-format.md.
+enum class AlphaMode : uint32_t { Opaque = 0, Mask = 1, Blend = 2 };
 
 struct Material {
   MaterialType type = MaterialType::Diffuse;
   Vec3 albedo{0.8f, 0.8f, 0.8f};  ///< diffuse albedo, mirror reflectance or glass transmittance tint
   Vec3 emission{0, 0, 0};         ///< emitted radiance Le from the front face (W / m^2 / sr)
   float ior = 1.5f;               ///< index of refraction (glass only)
+  TextureRef baseColorTexture;    ///< multiplies albedo (RGB) and alpha (A)
+  TextureRef opacityTexture;      ///< OBJ's map_d: alpha from its first channel
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alpha = 1.0f;             ///< baseColorFactor's alpha
+  float alphaCutoff = 0.5f;       ///< MASK: texels with alpha below this are cut out
+
+  PVR_HOST_DEVICE bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 
   PVR_HOST_DEVICE bool isSpecular() const { return type != MaterialType::Diffuse; }
   PVR_HOST_DEVICE bool isEmissive() const { return !isBlack(emission); }

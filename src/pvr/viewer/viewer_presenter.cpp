@@ -81,8 +81,9 @@ struct ViewerPresenter::Impl {
   VkDescriptorPool imguiPool = VK_NULL_HANDLE;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence frameFence = VK_NULL_HANDLE;
-  VkSemaphore imageAvailable = VK_NULL_HANDLE, renderFinished = VK_NULL_HANDLE;
-  bool imguiReady = false, stop = false, backendChange = false, screenshotRequested = false;
+  VkSemaphore imageAvailable = VK_NULL_HANDLE;
+  std::vector<VkSemaphore> renderFinished;  ///< one per swapchain image: a present may still wait on the last one
+  bool imguiReady = false, stop = false, backendChange = false, screenshotRequested = false, windowShotPending = false;
   // The head: position, yaw and pitch from the rig's start, driven by the mouse and WASD.
   Vec3 position;
   Quat start;
@@ -96,7 +97,6 @@ struct ViewerPresenter::Impl {
   std::vector<std::string> written;
   int screenshotCount = 0;
   std::optional<FoveationMask> mask;
-  int maskAcuity = -1;
   std::optional<FrameRequest> lastRequest;
 
   void shutdown();
@@ -125,11 +125,14 @@ struct ViewerPresenter::Impl {
       if (f.format == VK_FORMAT_B8G8R8A8_SRGB || f.format == VK_FORMAT_R8G8B8A8_SRGB) chosen = f;
     if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT))
       throw Error("the window's swapchain images cannot be copy targets (no TRANSFER_DST usage)");
-    swapReadable = caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    const bool eightBit = chosen.format == VK_FORMAT_B8G8R8A8_SRGB || chosen.format == VK_FORMAT_R8G8B8A8_SRGB ||
+                          chosen.format == VK_FORMAT_B8G8R8A8_UNORM || chosen.format == VK_FORMAT_R8G8B8A8_UNORM;
+    swapReadable = eightBit && (caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT);  // the window shot reads 8-bit RGBA
     swapFormat = chosen.format;
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     extent = caps.currentExtent.width != UINT32_MAX ? caps.currentExtent : VkExtent2D{uint32_t(w), uint32_t(h)};
+    if (extent.width == 0 || extent.height == 0) return;  // minimized: no swapchain until it is shown again
     VkSwapchainCreateInfoKHR sci{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
     sci.surface = surface;
     sci.minImageCount = std::max(caps.minImageCount, 2u);
@@ -189,6 +192,10 @@ struct ViewerPresenter::Impl {
       VkFramebuffer fb;
       vkCheck(vkCreateFramebuffer(vk->device(), &fci, nullptr, &fb), "vkCreateFramebuffer");
       framebuffers.push_back(fb);
+      VkSemaphoreCreateInfo semaphoreInfo{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+      VkSemaphore finished;
+      vkCheck(vkCreateSemaphore(vk->device(), &semaphoreInfo, nullptr, &finished), "vkCreateSemaphore");
+      renderFinished.push_back(finished);
     }
   }
 
@@ -196,7 +203,8 @@ struct ViewerPresenter::Impl {
     vkDeviceWaitIdle(vk->device());
     for (VkFramebuffer fb : framebuffers) vkDestroyFramebuffer(vk->device(), fb, nullptr);
     for (VkImageView v : views) vkDestroyImageView(vk->device(), v, nullptr);
-    framebuffers.clear(), views.clear(), swapImages.clear();
+    for (VkSemaphore s : renderFinished) vkDestroySemaphore(vk->device(), s, nullptr);
+    framebuffers.clear(), views.clear(), swapImages.clear(), renderFinished.clear();
     if (swapchain) vkDestroySwapchainKHR(vk->device(), swapchain, nullptr);
     swapchain = VK_NULL_HANDLE;
   }
@@ -352,7 +360,6 @@ ViewerPresenter::ViewerPresenter(const StereoRig& rig, const ViewerSettings& set
     vkCheck(vkCreateFence(m.vk->device(), &fci, nullptr, &m.frameFence), "vkCreateFence");
     VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
     vkCheck(vkCreateSemaphore(m.vk->device(), &sci, nullptr, &m.imageAvailable), "vkCreateSemaphore");
-    vkCheck(vkCreateSemaphore(m.vk->device(), &sci, nullptr, &m.renderFinished), "vkCreateSemaphore");
     m.makeEyes(false);
 
     VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16}};
@@ -375,7 +382,7 @@ ViewerPresenter::ViewerPresenter(const StereoRig& rig, const ViewerSettings& set
     ii.Queue = m.vk->queue();
     ii.DescriptorPool = m.imguiPool;
     ii.MinImageCount = 2;
-    ii.ImageCount = uint32_t(m.swapImages.size());
+    ii.ImageCount = uint32_t(std::max<size_t>(m.swapImages.size(), 2));
     ii.MSAASamples = VK_SAMPLE_COUNT_1_BIT;
     ii.CheckVkResultFn = checkVk;
     ImGui_ImplVulkan_Init(&ii, m.renderPass);
@@ -411,7 +418,6 @@ void ViewerPresenter::Impl::shutdown() {
     if (m.imguiPool) vkDestroyDescriptorPool(m.vk->device(), m.imguiPool, nullptr);
     if (m.frameFence) vkDestroyFence(m.vk->device(), m.frameFence, nullptr);
     if (m.imageAvailable) vkDestroySemaphore(m.vk->device(), m.imageAvailable, nullptr);
-    if (m.renderFinished) vkDestroySemaphore(m.vk->device(), m.renderFinished, nullptr);
     if (m.surface) vkDestroySurfaceKHR(m.vk->instance(), m.surface, nullptr);
     m.vk.reset();
   }
@@ -482,35 +488,37 @@ bool ViewerPresenter::waitFrame(FrameRequest& request) {
 }
 
 void ViewerPresenter::adjustOptions(RenderOptions& o) {
+  // Only what the panel changed since the last frame: the command line's options (a photon count
+  // that is no power of two, a --mask file) stay until their control is touched.
   Impl& m = *impl_;
   const ViewerSettings& s = m.settings;
-  o.photonsX = o.photonsY = 1u << s.photonsLog2;
-  o.gather.density.radius = s.radius;
-  o.map = s.map ? PhotonMapKind::KdTree : PhotonMapKind::HashGrid;
-  o.gather.density.estimator = s.estimator ? Estimator::Knn : Estimator::Radius;
-  o.gather.density.k = s.k;
+  ViewerSettings& a = m.applied;
+  if (s.photonsLog2 != a.photonsLog2) o.photonsX = o.photonsY = 1u << s.photonsLog2;
+  if (s.radius != a.radius) o.gather.density.radius = s.radius;
+  if (s.map != a.map) o.map = s.map ? PhotonMapKind::KdTree : PhotonMapKind::HashGrid;
+  if (s.estimator != a.estimator) o.gather.density.estimator = s.estimator ? Estimator::Knn : Estimator::Radius;
+  if (s.k != a.k) o.gather.density.k = s.k;
   const DensityKernel kernels[] = {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory, DensityKernel::CellSorted};
-  o.kernel = kernels[std::clamp(s.kernel, 0, 3)];
+  if (s.kernel != a.kernel) o.kernel = kernels[std::clamp(s.kernel, 0, 3)];
   const StereoMode modes[] = {StereoMode::Separate, StereoMode::Scatter, StereoMode::Gather};
-  o.stereo = modes[std::clamp(s.stereo, 0, 2)];
+  if (s.stereo != a.stereo) o.stereo = modes[std::clamp(s.stereo, 0, 2)];
   o.eyes[0] = true;
   o.eyes[1] = s.bothEyes;
-  if (o.temporal.enabled != s.taa) o.temporal.enabled = s.taa;
-  o.temporal.taa.blend = s.taaBlend;
-  if (s.foveated) {
-    if (!m.mask || m.maskAcuity != s.acuity) {
+  if (s.taa != a.taa) o.temporal.enabled = s.taa;
+  if (s.taaBlend != a.taaBlend) o.temporal.taa.blend = s.taaBlend;
+  if (s.foveated != a.foveated || (s.foveated && s.acuity != a.acuity)) {
+    if (s.foveated) {
       MaskParams params = maskParamsForRig(m.rig);
       params.acuity.kind = s.acuity ? AcuityKind::GeislerPerry : AcuityKind::LinearMar;
       m.mask = generateFoveationMask(params);
-      m.maskAcuity = s.acuity;
+      o.foveation.mask = &*m.mask;
+    } else {
+      o.foveation.mask = nullptr;
     }
-    o.foveation.mask = &*m.mask;
-  } else {
-    o.foveation.mask = nullptr;
   }
   m.transfer->setExposure(s.exposure);
-  if (s.backend != m.applied.backend) m.backendChange = true;
-  m.applied = s;
+  if (s.backend != a.backend) m.backendChange = true;
+  a = s;
 }
 
 void ViewerPresenter::present(const PresentedFrame& frame) {
@@ -528,6 +536,7 @@ void ViewerPresenter::present(const PresentedFrame& frame) {
       if (e == 1 && !frame.renderer.options().eyes[1]) continue;
       if (frame.onDevice) {
         sources[e].deviceImage = frame.renderer.deviceImage(Eye(e));
+        sources[e].deviceStream = frame.renderer.deviceStream();
       } else {
         sources[e].image = &frame.result->eyes[e].image;
       }
@@ -535,8 +544,13 @@ void ViewerPresenter::present(const PresentedFrame& frame) {
     }
     m.transfer->handOver(sources, targets);
   }
-  if (m.screenshotRequested) m.screenshot();
-
+  if (m.screenshotRequested) {
+    m.screenshot();
+    m.screenshotRequested = false;
+    m.windowShotPending = true;  // the window as shown this frame, panel included
+  }
+  if (!m.swapchain) m.createSwapchain();
+  if (!m.swapchain) return;  // minimized
   vkCheck(vkWaitForFences(m.vk->device(), 1, &m.frameFence, VK_TRUE, 5'000'000'000ull), "vkWaitForFences (window)");
   uint32_t index = 0;
   VkResult r = vkAcquireNextImageKHR(m.vk->device(), m.swapchain, 5'000'000'000ull, m.imageAvailable, VK_NULL_HANDLE, &index);
@@ -582,7 +596,7 @@ void ViewerPresenter::present(const PresentedFrame& frame) {
   vkCmdBeginRenderPass(cmd, &rp, VK_SUBPASS_CONTENTS_INLINE);
   ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd);
   vkCmdEndRenderPass(cmd);
-  const bool windowShot = m.screenshotRequested;
+  const bool windowShot = m.windowShotPending && m.swapReadable;
   if (!windowShot)
     transitionImage(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
   vkCheck(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
@@ -594,16 +608,15 @@ void ViewerPresenter::present(const PresentedFrame& frame) {
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd;
   si.signalSemaphoreCount = windowShot ? 0 : 1;
-  si.pSignalSemaphores = &m.renderFinished;
+  si.pSignalSemaphores = &m.renderFinished[index];
   vkCheck(vkQueueSubmit(m.vk->queue(), 1, &si, m.frameFence), "vkQueueSubmit (window)");
-  VkSemaphore presentWait = m.renderFinished;
+  VkSemaphore presentWait = m.renderFinished[index];
   if (windowShot) {  // read the window back before it is presented, then hand it on
     vkCheck(vkWaitForFences(m.vk->device(), 1, &m.frameFence, VK_TRUE, 5'000'000'000ull), "vkWaitForFences (window)");
     m.windowShot(index);
     m.vk->runOnce([&](VkCommandBuffer c) {
       transitionImage(c, target, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
     });
-    m.screenshotRequested = false;
     presentWait = VK_NULL_HANDLE;
   }
   VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
@@ -612,6 +625,7 @@ void ViewerPresenter::present(const PresentedFrame& frame) {
   pi.swapchainCount = 1;
   pi.pSwapchains = &m.swapchain;
   pi.pImageIndices = &index;
+  m.windowShotPending = false;
   r = vkQueuePresentKHR(m.vk->queue(), &pi);
   if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) {
     m.destroySwapchain();

@@ -42,19 +42,28 @@ struct EyeTransfer::Slot {
   std::unique_ptr<cuda::SharedSurface> cudaSurface[2];
   std::unique_ptr<cuda::SharedBuffer> cudaColour[2], cudaDepth[2];
   std::unique_ptr<cuda::SharedSemaphore> encoded;
+  std::unique_ptr<cuda::HandOverEvents> timing;
 #endif
   VkSemaphore encodedSemaphore = VK_NULL_HANDLE;  ///< CUDA signals it, the copy waits on it
 };
 
 struct EyeTransfer::CudaState {
-#ifdef PVR_HAVE_CUDA
-  cuda::HandOverStream stream;
-#endif
   PFN_vkGetMemoryFdKHR getMemoryFd = nullptr;
   PFN_vkGetSemaphoreFdKHR getSemaphoreFd = nullptr;
 };
 
 EyeTransfer::EyeTransfer(VulkanContext& vk, const EyeTransferOptions& options) : vk_(vk), options_(options) {
+  try {
+    build();
+  } catch (...) {
+    release();  // what was made before the failure
+    throw;
+  }
+}
+
+void EyeTransfer::build() {
+  VulkanContext& vk = vk_;
+  const EyeTransferOptions& options = options_;
   if (options.width <= 0 || options.height <= 0) throw Error("eye transfer: the eye size must be positive");
   const bool shared = options.path == HandOverPath::CudaShared;
 #ifndef PVR_HAVE_CUDA
@@ -76,7 +85,8 @@ EyeTransfer::EyeTransfer(VulkanContext& vk, const EyeTransferOptions& options) :
   // (0.23 against 0.36 ms for two 1440x1600 eyes: docs/xr.md).
   sharedImages_ = shared && options.colourViaImage;
   for (int s = 0; s < 2; ++s) {
-    auto slot = std::make_unique<Slot>();
+    slots_.push_back(std::make_unique<Slot>());  // owned at once: release() cleans up after a failure
+    Slot* slot = slots_.back().get();
     for (int e = 0; e < 2; ++e) {
       if (shared) {
 #ifdef PVR_HAVE_CUDA
@@ -102,7 +112,6 @@ EyeTransfer::EyeTransfer(VulkanContext& vk, const EyeTransferOptions& options) :
             sharedImages_ = false;
             for (auto& old : slots_)
               for (int i = 0; i < 2; ++i) old->cudaSurface[i].reset(), old->colourImage[i] = VulkanImage();
-            for (int i = 0; i < 2; ++i) slot->cudaSurface[i].reset(), slot->colourImage[i] = VulkanImage();
           }
         }
 #endif
@@ -138,6 +147,7 @@ EyeTransfer::EyeTransfer(VulkanContext& vk, const EyeTransferOptions& options) :
       int fd = -1;
       vkCheck(cuda_->getSemaphoreFd(vk.device(), &info, &fd), "vkGetSemaphoreFdKHR");
       slot->encoded = std::make_unique<cuda::SharedSemaphore>(fd);
+      slot->timing = std::make_unique<cuda::HandOverEvents>();
 #endif
     }
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
@@ -147,7 +157,6 @@ EyeTransfer::EyeTransfer(VulkanContext& vk, const EyeTransferOptions& options) :
     vkCheck(vkAllocateCommandBuffers(vk.device(), &ai, &slot->cmd), "vkAllocateCommandBuffers");
     VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     vkCheck(vkCreateFence(vk.device(), &fci, nullptr, &slot->fence), "vkCreateFence");
-    slots_.push_back(std::move(slot));
   }
 #ifdef PVR_HAVE_CUDA
   if (shared && !sharedImages_)
@@ -174,18 +183,25 @@ EyeTransfer::EyeTransfer(VulkanContext& vk, const EyeTransferOptions& options) :
   }
 }
 
-EyeTransfer::~EyeTransfer() {
+EyeTransfer::~EyeTransfer() { release(); }
+
+void EyeTransfer::release() {
+#ifdef PVR_HAVE_CUDA
+  if (cuda_) cuda::synchronizeStreamQuietly(lastStream_);  // no kernel may still write the memory freed below
+#endif
   vkDeviceWaitIdle(vk_.device());
   for (auto& slot : slots_) {
-    vkDestroyFence(vk_.device(), slot->fence, nullptr);
-    vkFreeCommandBuffers(vk_.device(), vk_.commandPool(), 1, &slot->cmd);
+    if (slot->fence) vkDestroyFence(vk_.device(), slot->fence, nullptr);
+    if (slot->cmd) vkFreeCommandBuffers(vk_.device(), vk_.commandPool(), 1, &slot->cmd);
 #ifdef PVR_HAVE_CUDA
     slot->encoded.reset();
     for (int e = 0; e < 2; ++e) slot->cudaColour[e].reset(), slot->cudaDepth[e].reset(), slot->cudaSurface[e].reset();
 #endif
     if (slot->encodedSemaphore) vkDestroySemaphore(vk_.device(), slot->encodedSemaphore, nullptr);
   }
+  slots_.clear();
   if (timestamps_) vkDestroyQueryPool(vk_.device(), timestamps_, nullptr);
+  timestamps_ = VK_NULL_HANDLE;
 }
 
 namespace {
@@ -208,6 +224,7 @@ void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2],
   const size_t pixels = size_t(options_.width) * options_.height;
   const int bpp = displayBytesPerPixel(options_.encoding);
   bool anyCuda = false;
+  void* stream = nullptr;  // the renderer's: its next frame cannot overwrite the images before the encode read them
   auto hostStart = std::chrono::steady_clock::now();
   for (int e = 0; e < 2; ++e) {
     const EyeSource& src = source[e];
@@ -215,17 +232,21 @@ void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2],
     if (src.deviceImage) {
 #ifdef PVR_HAVE_CUDA
       if (!cuda_) throw Error("eye transfer: GPU images need the CUDA hand-over path");
-      if (!anyCuda) cuda_->stream.begin();
+      if (!anyCuda) {
+        stream = src.deviceStream;
+        lastStream_ = stream;
+        slot.timing->begin(stream);
+      }
       anyCuda = true;
       float* depth = options_.depth ? static_cast<float*>(slot.cudaDepth[e]->data()) : nullptr;
       if (sharedImages_)
         cuda::encodeEyeToSurface(src.deviceImage, options_.depth ? src.deviceInverseDepth : nullptr, options_.width,
                                  options_.height, options_.exposure, options_.encoding, options_.nearZ,
-                                 slot.cudaSurface[e]->surface(), depth, cuda_->stream.stream());
+                                 slot.cudaSurface[e]->surface(), depth, stream);
       else
         cuda::encodeEyeForDisplay(src.deviceImage, options_.depth ? src.deviceInverseDepth : nullptr, pixels,
                                   options_.exposure, options_.encoding, options_.nearZ, slot.cudaColour[e]->data(), depth,
-                                  cuda_->stream.stream());
+                                  stream);
 #else
       throw Error("eye transfer: GPU images without a CUDA build");
 #endif
@@ -251,8 +272,8 @@ void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2],
   lastHostEncodeMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - hostStart).count();
 #ifdef PVR_HAVE_CUDA
   if (anyCuda) {
-    cuda_->stream.end();
-    slot.encoded->signal(cuda_->stream.stream());
+    slot.timing->end(stream);
+    slot.encoded->signal(stream);
   }
 #endif
 
@@ -328,12 +349,15 @@ HandOverTiming EyeTransfer::lastTiming() {
       t.copyMs = double(ticks[1] - ticks[0]) * timestampPeriodNs_ * 1e-6;
   }
 #ifdef PVR_HAVE_CUDA
-  if (cuda_) t.encodeMs = cuda_->stream.lastMs();
+  if (cuda_ && slot.timing && slot.timing->recorded()) t.encodeMs = slot.timing->lastMs();
 #endif
   return t;
 }
 
 void EyeTransfer::waitIdle() {
+#ifdef PVR_HAVE_CUDA
+  if (cuda_) cuda::synchronizeStream(lastStream_);
+#endif
   for (auto& slot : slots_)
     if (slot->submitted) waitFence(vk_.device(), slot->fence), slot->submitted = false;
 }

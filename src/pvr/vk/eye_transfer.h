@@ -28,6 +28,7 @@ struct EyeSource {
   const std::vector<float>* inverseDepth = nullptr;
   const Vec3* deviceImage = nullptr;
   const float* deviceInverseDepth = nullptr;
+  void* deviceStream = nullptr;  ///< the stream that wrote the device buffers (Renderer::deviceStream): the encode runs on it
   bool present() const { return image || deviceImage; }
 };
 
@@ -86,8 +87,11 @@ class EyeTransfer {
   double timestampPeriodNs_ = 1.0;
   bool timestampsValid_ = false;
   struct CudaState;
+  void build();
   std::unique_ptr<CudaState> cuda_;
   double lastHostEncodeMs_ = 0;
+  void* lastStream_ = nullptr;
+  void release();
   bool sharedImages_ = false;
 };
 

@@ -368,6 +368,10 @@ std::vector<unsigned char> readImage(VulkanContext& vk, VkImage image, VkImageAs
     region.imageSubresource = {aspect, 0, 0, 1};
     region.imageExtent = {uint32_t(width), uint32_t(height), 1};
     vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.buffer, 1, &region);
+    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0, nullptr);
     transitionImage(cmd, image, aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout);
   });
   const unsigned char* p = static_cast<const unsigned char*>(staging.mapped);

@@ -447,6 +447,10 @@ bool XrPresenter::waitFrame(FrameRequest& request) {
         std::chrono::duration<double>(LoopClock::now() - m.stopRequestedAt).count() > m.options.stopTimeoutSeconds)
       throw Error("the OpenXR runtime did not end the session within " + std::to_string(int(m.options.stopTimeoutSeconds)) + " s of the exit request");
     if (!lifecycle_.running()) {
+      if (m.options.stop && m.options.stop->load() && !lifecycle_.stopRequested()) {
+        requestStop();  // e.g. Ctrl-C while the runtime holds the session stopped (headset off)
+        continue;
+      }
       if (lifecycle_.sessionsBegun() == 0 &&
           std::chrono::duration<double>(LoopClock::now() - m.waitingSince).count() > m.options.readyTimeoutSeconds)
         throw Error("the OpenXR session did not become ready within " + std::to_string(int(m.options.readyTimeoutSeconds)) +
@@ -522,6 +526,7 @@ void XrPresenter::present(const PresentedFrame& frame) {
       if (frame.onDevice) {
         sources[e].deviceImage = frame.renderer.deviceImage(Eye(e));
         sources[e].deviceInverseDepth = frame.renderer.deviceInverseDepth(Eye(e));
+        sources[e].deviceStream = frame.renderer.deviceStream();
       } else {
         sources[e].image = &frame.result->eyes[e].image;
         sources[e].inverseDepth = &frame.result->eyes[e].inverseDepth;

@@ -5,6 +5,7 @@
 // per frame xrWaitFrame -> xrLocateViews at the predicted display time -> the views become the
 // rig -> render -> hand-over into the acquired swapchain images -> xrEndFrame with a projection
 // layer (and a depth layer when the runtime offers XR_KHR_composition_layer_depth).
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -27,6 +28,7 @@ struct XrPresenterOptions {
   bool colourViaImage = false;       ///< CUDA hand-over through a shared image (else a shared buffer)
   double readyTimeoutSeconds = 10;   ///< the session must become READY within this
   double stopTimeoutSeconds = 5;     ///< after a stop request, the runtime must end the session within this
+  const std::atomic<bool>* stop = nullptr;  ///< Ctrl-C: seen also while waiting for the runtime (a stopped session)
 };
 
 // What the presenter found and chose, for the log and the statistics.
