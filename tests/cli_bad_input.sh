@@ -35,7 +35,7 @@ expect_error "no such file" render "$data/missing.gltf" "${small[@]}"
 expect_error "unsupported scene format" render "$data/not_a_scene.txt" "${small[@]}"
 expect_error "malformed JSON" render "$data/malformed.json" "${small[@]}"
 expect_error "cannot read" render "$data/malformed.gltf" "${small[@]}"
-expect_error "no light" render "$data/no_light.obj" "${small[@]}"
+expect_error "no light" render "$data/no_light.json" "${small[@]}"
 expect_error "photons must be" render cornell --photons 0 --eye-size 8x8
 expect_error "--backend must be" render cornell --backend gpu --eye-size 8x8
 expect_error "--kernel must be" render cornell --kernel fused --eye-size 8x8

@@ -89,7 +89,7 @@ TEST(SceneErrors, EachBadInputThrowsAClearError) {
       {kData + "/not_a_scene.txt", "unsupported scene format '.txt'"},
       {kData + "/malformed.json", "malformed JSON"},
       {kData + "/malformed.gltf", "cannot read"},
-      {kData + "/no_light.obj", "has no light"},
+      {kData + "/no_light.json", "has no light"},
       {"cornel", "no such file or built-in scene"},
   };
   for (const Case& c : cases) {

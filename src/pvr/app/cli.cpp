@@ -275,8 +275,9 @@ int runRender(const RenderArgs& a) {
   const std::vector<TrajectoryFrame>& trajectory = setup->trajectory;
   ensureParentDirectory(a.out);  // before the work, not after it
   std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(setup->backend, scene);
-  std::printf("scene %s: %u triangles, %u emitting; eyes %dx%d, IPD %.1f mm\n", scene.name.c_str(),
-              scene.triangleCount(), scene.lightTriangleCount(), rig.width, rig.height, rig.ipd * 1000.0f);
+  std::printf("scene %s: %u triangles, %u emitting, %zu point/spot/sun lights, %u textures; eyes %dx%d, IPD %.1f mm\n",
+              scene.name.c_str(), scene.triangleCount(), scene.lightTriangleCount(), scene.punctualLights().size(),
+              scene.textureCount(), rig.width, rig.height, rig.ipd * 1000.0f);
   std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, seed %u\n", options.photonsX,
               options.photonsY, options.gather.density.radius, a.map.c_str(), a.estimator.c_str(),
               options.gather.density.estimator == Estimator::Knn ? (" (k=" + std::to_string(a.k) + ")").c_str() : "",

@@ -16,6 +16,7 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   materials.upload(scene.materials().data(), scene.materials().size(), "materials");
   lightTriangles.upload(host.lightTriangles, host.lightCount, "light triangles");
   lightCdf.upload(host.lightCdf, size_t(host.lightCount) + 1, "light CDF");
+  if (host.punctualCount) punctualLights.upload(host.punctualLights, host.punctualCount, "punctual lights");
   for (int set = 0; set < 2; ++set)
     if (host.uvs[set]) uvs[set].upload(host.uvs[set], vertexCount, "texture coordinates");
   // Textures: one texel buffer; the views' pointers rebased onto it.
@@ -43,6 +44,7 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   view.materials = materials.data();
   view.lightTriangles = lightTriangles.data();
   view.lightCdf = lightCdf.data();
+  view.punctualLights = host.punctualCount ? punctualLights.data() : nullptr;
   for (int set = 0; set < 2; ++set) view.uvs[set] = host.uvs[set] ? uvs[set].data() : nullptr;
   view.textures = deviceTextures.empty() ? nullptr : textures.data();
   intersector.alphaTest = scene.hasAlphaTestedMaterial();

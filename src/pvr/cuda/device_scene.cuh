@@ -16,6 +16,7 @@ struct DeviceScene {
   DeviceBuffer<TextureView> textures;    ///< pointing into `texels`
   DeviceBuffer<uint32_t> indices, materialIds, lightTriangles;
   DeviceBuffer<Material> materials;
+  DeviceBuffer<PunctualLight> punctualLights;
   DeviceBuffer<float> lightCdf;
   DeviceBuffer<BvhNode> nodes;
   DeviceBuffer<BvhTriangle> triangles;

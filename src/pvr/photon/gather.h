@@ -71,9 +71,24 @@ PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Interse
       Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
       Vec3 nShade = front ? sp.shadingNormal : -sp.shadingNormal;
       Vec3 brdf = scene.albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo)) * kInvPi;
-      if (params.mode == ShadingMode::Full && scene.lightCount > 0) {
+      if (params.mode == ShadingMode::Full) {
+        // Every point, spot and distant light exactly (one shadow ray each), plus one sample of
+        // the area lights: unbiased, and no selection noise among a handful of lights.
+        for (uint32_t k = 0; k < scene.punctualCount; ++k) {
+          LightSample ls;
+          ls.punctual = int(k);
+          ls.pick = 1.0f;
+          PunctualIllumination li = illuminate(scene, ls, sp.position, eps);
+          float cosSurface = dot(nShade, li.wi);
+          if (cosSurface > 0.0f && dot(nGeo, li.wi) > 0.0f && !isBlack(li.irradiance)) {
+            Ray shadow{sp.position + nGeo * eps, li.wi};
+            if (!intersector.occluded(shadow, li.shadowDistance)) out.radiance += throughput * brdf * li.irradiance * cosSurface;
+          }
+        }
+      }
+      if (params.mode == ShadingMode::Full && scene.triangleLightCount > 0) {
         float uPick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-        LightSample ls = sampleLight(scene, uPick, u1, u2);
+        LightSample ls = sampleAreaLight(scene, uPick, u1, u2);
         Vec3 toLight = ls.position - sp.position;
         float dist2 = lengthSquared(toLight);
         float dist = sqrtf(dist2);

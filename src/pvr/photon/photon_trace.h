@@ -2,9 +2,11 @@
 // Photon tracing from the area lights (the first pass of photon mapping), written once for any
 // Intersector with `bool intersect(const Ray&, float tMax, Hit&) const`.
 //
-// Emission: a light triangle chosen in proportion to its power, a uniform point on it, a
+// Emission: a light chosen in proportion to its power. From a triangle: a uniform point on it, a
 // cosine-weighted direction; the photon carries Le * pi * area / (pdf_pick * N), which is exactly
-// Phi / N when all lights share one colour. At a diffuse surface the photon is stored, then
+// Phi / N when all lights share one colour. A point light: a uniform direction, 4 pi I / (pick N);
+// a spot: uniform within the outer cone, weighted by its falloff; a distant light: a uniform point
+// on a disk as wide as the scene's bounding sphere, upstream of it, carrying E pi R^2 / (pick N). At a diffuse surface the photon is stored, then
 // continues with Russian roulette (probability = max albedo component, power scaled so the
 // expectation is unchanged). Mirrors reflect and glass reflects or refracts (by Fresnel); photons
 // are never stored on them.
@@ -30,8 +32,32 @@ PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTra
   // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
   float uTheta = rng.uniform();
   float uPhi = rng.uniform();
-  Vec3 local = sampleCosineHemisphere(uTheta, uPhi);
   Photon p;
+  if (ls.punctual >= 0) {
+    const PunctualLight& l = scene.punctualLights[ls.punctual];
+    const float n = float(params.photonCount) * ls.pick;
+    if (l.kind == PunctualKind::Directional) {
+      Frame frame = Frame::fromNormal(l.direction);
+      const bool aimed = l.aimRadius > 0.0f;
+      const float radius = aimed ? l.aimRadius : scene.sceneRadius;
+      const Vec3 center = aimed ? l.position : scene.sceneCenter;
+      float r = radius * sqrtf(u1), phi = 2.0f * kPi * u2;
+      // Upstream of everything: the disk's centre moved back past the whole scene.
+      float back = length(center - scene.sceneCenter) + 2.0f * scene.sceneRadius;
+      p.position = center - l.direction * back + frame.toWorld({r * cosf(phi), r * sinf(phi), 0.0f});
+      p.direction = l.direction;
+      p.power = l.intensity * (kPi * radius * radius / n);
+      return p;
+    }
+    float cosMin = l.kind == PunctualKind::Spot ? l.cosOuter : -1.0f;  // uniform in the cone (the sphere: -1)
+    float cosTheta = 1.0f - uTheta * (1.0f - cosMin), sinTheta = sqrtf(fmaxf(0.0f, 1.0f - cosTheta * cosTheta));
+    float phi = 2.0f * kPi * uPhi;
+    p.position = l.position;
+    p.direction = Frame::fromNormal(l.direction).toWorld({sinTheta * cosf(phi), sinTheta * sinf(phi), cosTheta});
+    p.power = l.intensity * (l.falloff(cosTheta) * 2.0f * kPi * (1.0f - cosMin) / n);
+    return p;
+  }
+  Vec3 local = sampleCosineHemisphere(uTheta, uPhi);
   p.position = ls.position;
   p.direction = Frame::fromNormal(ls.normal).toWorld(local);
   p.power = ls.emission * (kPi / (ls.pdfArea * float(params.photonCount)));

@@ -1,19 +1,24 @@
-// Mesh import through assimp. Material mapping (textures are not supported yet: the base colour
-// factor alone is used):
-//   glTF 2.0: baseColorFactor -> diffuse albedo; emissiveFactor -> Le; metallic >= 0.5 with
-//             roughness <= 0.1 -> mirror (reflectance = base colour); KHR_materials_transmission
-//             >= 0.5 -> glass (ior from KHR_materials_ior, default 1.5).
-//   OBJ/MTL:  Kd -> albedo; Ke -> Le; illum 3 or 5 -> mirror (reflectance Ks, else Kd);
-//             illum 4, 6, 7 or 9, or d < 0.5 -> glass (ior Ni).
+// Mesh import through assimp. Material mapping:
+//   glTF 2.0: baseColorFactor (x baseColorTexture) -> diffuse albedo; emissiveFactor -> Le;
+//             metallic >= 0.5 with roughness <= 0.1 -> mirror (reflectance = base colour);
+//             KHR_materials_transmission >= 0.5 -> glass (ior from KHR_materials_ior, default 1.5);
+//             alphaMode MASK / BLEND with alphaCutoff -> alpha-tested cut-outs.
+//   OBJ/MTL:  Kd (x map_Kd) -> albedo; Ke -> Le; illum 3 or 5 -> mirror (reflectance Ks, else Kd);
+//             illum 4, 6, 7 or 9, or d < 0.5 without map_d -> glass (ior Ni); map_d -> cut-out.
+//   3DS:      diffuse colour (x its texture map) -> albedo.
+// Texture coordinates are taken with assimp's FlipUVs, so v runs down the image as the texels do.
+#include <assimp/GltfMaterial.h>
 #include <assimp/ObjMaterial.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <assimp/Importer.hpp>
 #include <filesystem>
 
 #include "pvr/scene/scene.h"
+#include "pvr/scene/texture_file.h"
 #include "pvr/util/error.h"
 
 namespace pvr {
@@ -21,7 +26,45 @@ namespace {
 
 Vec3 toVec3(const aiColor3D& c) { return {c.r, c.g, c.b}; }
 
-Material convertMaterial(const aiMaterial& am) {
+WrapMode wrapOf(aiTextureMapMode mode) {
+  switch (mode) {
+    case aiTextureMapMode_Clamp:
+    case aiTextureMapMode_Decal: return WrapMode::ClampToEdge;
+    case aiTextureMapMode_Mirror: return WrapMode::MirroredRepeat;
+    default: return WrapMode::Repeat;
+  }
+}
+
+// The material's texture of one kind: an embedded image ("*N" or a .glb's own), or a file next to
+// the model. None (texture -1) when there is no such texture or it cannot be read.
+TextureRef textureOf(const aiScene& as, const aiMaterial& am, aiTextureType type, bool srgb, const std::string& folder,
+                     TextureLoader& loader) {
+  TextureRef ref;
+  aiString file;
+  aiTextureMapMode modes[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
+  unsigned uvIndex = 0;
+  if (am.GetTextureCount(type) == 0 || am.GetTexture(type, 0, &file, nullptr, &uvIndex, nullptr, nullptr, modes) != AI_SUCCESS)
+    return ref;
+  int source = 0;
+  if (am.Get(AI_MATKEY_UVWSRC(type, 0), source) == AI_SUCCESS) uvIndex = unsigned(source);
+  ref.texCoord = uvIndex > 1 ? 0u : uvIndex;
+  WrapMode s = wrapOf(modes[0]), t = wrapOf(modes[1]);
+  if (const aiTexture* embedded = as.GetEmbeddedTexture(file.C_Str())) {
+    std::string key = std::string("embedded ") + file.C_Str();
+    if (embedded->mHeight == 0)
+      ref.texture = loader.fromMemory(key, reinterpret_cast<const unsigned char*>(embedded->pcData), embedded->mWidth, srgb, s, t);
+    else
+      ref.texture = loader.fromBgra(key, reinterpret_cast<const unsigned char*>(embedded->pcData), int(embedded->mWidth),
+                                    int(embedded->mHeight), srgb, s, t);
+  } else {
+    std::string name = file.C_Str();
+    std::replace(name.begin(), name.end(), '\\', '/');
+    ref.texture = loader.fromFile((std::filesystem::path(folder) / name).string(), srgb, s, t);
+  }
+  return ref;
+}
+
+Material convertMaterial(const aiScene& as, const aiMaterial& am, const std::string& folder, TextureLoader& textures) {
   Material m;
   aiColor3D color(0.8f, 0.8f, 0.8f);
   if (am.Get(AI_MATKEY_BASE_COLOR, color) != AI_SUCCESS) am.Get(AI_MATKEY_COLOR_DIFFUSE, color);
@@ -41,7 +84,23 @@ Material convertMaterial(const aiMaterial& am) {
   am.Get(AI_MATKEY_OBJ_ILLUM, illum);
   if (am.Get(AI_MATKEY_REFRACTI, ior) != AI_SUCCESS || !(ior >= 1.0f && ior < 10.0f)) ior = 1.5f;
   bool objGlass = illum == 4 || illum == 6 || illum == 7 || illum == 9;
-  if (transmission >= 0.5f || objGlass || opacity < 0.5f) {
+  m.baseColorTexture = textureOf(as, am, aiTextureType_BASE_COLOR, true, folder, textures);
+  if (!m.baseColorTexture.present()) m.baseColorTexture = textureOf(as, am, aiTextureType_DIFFUSE, true, folder, textures);
+  m.opacityTexture = textureOf(as, am, aiTextureType_OPACITY, false, folder, textures);
+  aiString alphaMode;
+  const bool gltf = am.Get(AI_MATKEY_GLTF_ALPHAMODE, alphaMode) == AI_SUCCESS;
+  if (gltf) {
+    std::string mode = alphaMode.C_Str();
+    m.alphaMode = mode == "MASK" ? AlphaMode::Mask : mode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+    am.Get(AI_MATKEY_GLTF_ALPHACUTOFF, m.alphaCutoff);
+    aiColor4D base(1, 1, 1, 1);
+    if (am.Get(AI_MATKEY_BASE_COLOR, base) == AI_SUCCESS && std::isfinite(base.a)) m.alpha = std::clamp(base.a, 0.0f, 1.0f);
+  } else if (m.opacityTexture.present()) {  // OBJ map_d: a cut-out, not glass
+    m.alphaMode = AlphaMode::Mask;
+    m.alpha = std::isfinite(opacity) ? std::clamp(opacity, 0.0f, 1.0f) : 1.0f;
+  }
+  if (!(m.alphaCutoff >= 0.0f && m.alphaCutoff <= 1.0f)) m.alphaCutoff = 0.5f;
+  if (transmission >= 0.5f || objGlass || (!gltf && opacity < 0.5f && !m.opacityTexture.present())) {
     m.type = MaterialType::Glass;
     m.ior = ior;
     aiColor3D tint(1, 1, 1);
@@ -75,7 +134,8 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
                 "' (use .json, .gltf, .glb or .obj)");
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* as = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                                                  aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+                                                  aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+                                                  aiProcess_FlipUVs);
   if (!as) {
     std::string why = importer.GetErrorString();
     why.erase(std::remove(why.begin(), why.end(), '\n'), why.end());
@@ -84,13 +144,37 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
   if ((as->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !as->mRootNode)
     throw Error("cannot read '" + path + "': the file is incomplete");
   std::vector<uint32_t> materialMap(as->mNumMaterials);
+  TextureLoader textures(scene);
+  const std::string folder = fs::path(path).parent_path().string();
   for (unsigned i = 0; i < as->mNumMaterials; ++i)
   {
-    Material m = convertMaterial(*as->mMaterials[i]);
+    Material m = convertMaterial(*as, *as->mMaterials[i], folder, textures);
     m.emission *= options.emissionScale;
     materialMap[i] = scene.addMaterial(m, as->mMaterials[i]->GetName().C_Str());
   }
   if (as->mNumMaterials == 0) materialMap.push_back(scene.addMaterial(Material{}, "default"));
+  if (options.importLights)
+    for (unsigned li = 0; li < as->mNumLights; ++li) {
+      const aiLight& al = *as->mLights[li];
+      PunctualLight l;
+      if (al.mType == aiLightSource_POINT) l.kind = PunctualKind::Point;
+      else if (al.mType == aiLightSource_SPOT) l.kind = PunctualKind::Spot;
+      else if (al.mType == aiLightSource_DIRECTIONAL) l.kind = PunctualKind::Directional;
+      else continue;  // ambient and area lights of other formats: not imported
+      l.position = options.rotation.rotate(Vec3(al.mPosition.x, al.mPosition.y, al.mPosition.z) * options.scale) + options.translation;
+      Vec3 d = options.rotation.rotate(Vec3(al.mDirection.x, al.mDirection.y, al.mDirection.z));
+      l.direction = lengthSquared(d) > 0.0f ? normalize(d) : Vec3(0, -1, 0);
+      l.intensity = Vec3(al.mColorDiffuse.r, al.mColorDiffuse.g, al.mColorDiffuse.b);
+      if (l.kind == PunctualKind::Spot) {
+        float outer = std::clamp(al.mAngleOuterCone, 1e-3f, 0.5f * kPi), inner = std::clamp(al.mAngleInnerCone, 0.0f, outer);
+        l.cosOuter = std::cos(outer), l.cosInner = std::cos(inner);
+      }
+      try {
+        scene.addPunctualLight(l, al.mName.C_Str());
+      } catch (const Error& e) {
+        std::fprintf(stderr, "photonvr: warning: '%s': light skipped: %s\n", path.c_str(), e.what());
+      }
+    }
   for (unsigned mi = 0; mi < as->mNumMeshes; ++mi) {
     const aiMesh* mesh = as->mMeshes[mi];
     if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
@@ -107,6 +191,13 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
         normals[v] = isFinite(n) && lengthSquared(n) > 0 ? normalize(n) : Vec3(0.0f);
       }
     }
+    std::vector<Vec2> uvs[2];
+    for (int set = 0; set < 2; ++set)
+      if (mesh->HasTextureCoords(unsigned(set))) {
+        uvs[set].resize(mesh->mNumVertices);
+        for (unsigned v = 0; v < mesh->mNumVertices; ++v)
+          uvs[set][v] = {mesh->mTextureCoords[set][v].x, mesh->mTextureCoords[set][v].y};
+      }
     std::vector<uint32_t> indices;
     indices.reserve(mesh->mNumFaces * 3);
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
@@ -116,7 +207,7 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
     }
     uint32_t material = mesh->mMaterialIndex < materialMap.size() ? materialMap[mesh->mMaterialIndex] : materialMap[0];
     std::string meshName = mesh->mName.length ? mesh->mName.C_Str() : fs::path(path).filename().string();
-    scene.addMesh(meshName, vertices, normals, indices, material);
+    scene.addMesh(meshName, vertices, normals, uvs, indices, material);
   }
 }
 

@@ -84,9 +84,16 @@ void Scene::finalize() {
     lightTriangles_.push_back(t);
     lightCdf_.push_back(lightCdf_.back() + w);
   }
-  if (lightTriangles_.empty()) throw Error("scene '" + name + "' has no light (no emissive triangle)");
   Bounds3 b = bounds();
   sceneRadius_ = std::max(0.5f * length(b.extent()), 1e-3f);
+  sceneCenter_ = (b.lower + b.upper) * 0.5f;
+  // Punctual lights after the triangles, weighted on the same scale (power / pi).
+  for (const PunctualLight& l : punctualLights_) {
+    float w = luminance(punctualPower(l, sceneRadius_)) / kPi;
+    lightCdf_.push_back(lightCdf_.back() + (w > 0.0f ? w : 0.0f));
+  }
+  if (!(lightCdf_.back() > 0.0f))
+    throw Error("scene '" + name + "' has no light (no emissive triangle, no point, spot or sun light)");
 }
 
 uint32_t Scene::addTexture(const std::string& textureName, int width, int height, std::vector<uint32_t> rgba, bool srgb,
@@ -137,6 +144,22 @@ uint32_t Scene::addTexture(const std::string& textureName, int width, int height
   return uint32_t(textures_.size() - 1);
 }
 
+uint32_t Scene::addPunctualLight(const PunctualLight& light, const std::string& lightName) {
+  PunctualLight l = light;
+  const std::string what = "light '" + lightName + "'";
+  if (!isFinite(l.position) || !isFinite(l.direction) || !isFinite(l.intensity))
+    throw Error(what + " has a non-finite position, direction or intensity");
+  if (l.intensity.x < 0 || l.intensity.y < 0 || l.intensity.z < 0) throw Error(what + " has a negative intensity");
+  if (l.kind != PunctualKind::Point) {
+    if (!(lengthSquared(l.direction) > 0.0f)) throw Error(what + " has no direction");
+    l.direction = normalize(l.direction);
+  }
+  if (l.kind == PunctualKind::Spot && !(l.cosOuter >= 0.0f && l.cosOuter < 1.0f && l.cosInner >= l.cosOuter && l.cosInner <= 1.0f))
+    throw Error(what + ": a spot's cone angles must satisfy 0 <= inner <= outer, 0 < outer <= 90 degrees");
+  punctualLights_.push_back(l);
+  return uint32_t(punctualLights_.size() - 1);
+}
+
 bool Scene::hasAlphaTestedMaterial() const {
   return std::any_of(materials_.begin(), materials_.end(), [](const Material& m) { return m.alphaTested(); });
 }
@@ -156,8 +179,12 @@ SceneView Scene::view() const {
   v.triangleCount = triangleCount();
   v.lightTriangles = lightTriangles_.data();
   v.lightCdf = lightCdf_.data();
-  v.lightCount = uint32_t(lightTriangles_.size());
+  v.triangleLightCount = uint32_t(lightTriangles_.size());
+  v.punctualLights = punctualLights_.empty() ? nullptr : punctualLights_.data();
+  v.punctualCount = uint32_t(punctualLights_.size());
+  v.lightCount = v.triangleLightCount + (lightCdf_.size() > lightTriangles_.size() + 1 ? v.punctualCount : 0);
   v.sceneRadius = sceneRadius_;
+  v.sceneCenter = sceneCenter_;
   return v;
 }
 
@@ -177,6 +204,7 @@ Vec3 Scene::totalLightPower() const {
   SceneView v = view();
   Vec3 power{0, 0, 0};
   for (uint32_t t : lightTriangles_) power += materials_[materialIds_[t]].emission * (kPi * v.triangleArea(t));
+  for (const PunctualLight& l : punctualLights_) power += punctualPower(l, sceneRadius_);
   return power;
 }
 

@@ -37,6 +37,10 @@ class Scene {
   const std::vector<TextureView>& textureViews() const { return textures_; }  ///< texels point into this scene
   const std::vector<Vec2>& uvs(int set) const { return uvs_[set]; }
   const std::vector<uint32_t>& materialIds() const { return materialIds_; }
+  // A point, spot or distant light (lights without area). Throws pvr::Error for non-finite or
+  // negative values, a zero direction, or cones outside (0, 90] degrees with inner <= outer.
+  uint32_t addPunctualLight(const PunctualLight& light, const std::string& name);
+  const std::vector<PunctualLight>& punctualLights() const { return punctualLights_; }
   // Builds the light list; throws pvr::Error if nothing emits light or the scene is empty.
   void finalize();
 
@@ -73,9 +77,11 @@ class Scene {
   std::vector<std::string> materialNames_;
   std::vector<MeshRange> meshes_;
   std::vector<uint32_t> lightTriangles_;
+  std::vector<PunctualLight> punctualLights_;
   std::vector<float> lightCdf_;
   uint64_t skippedTriangles_ = 0;
   float sceneRadius_ = 1.0f;
+  Vec3 sceneCenter_{0, 0, 0};
 };
 
 // Built-in scenes by name ("cornell", "cornell-caustics"); throws pvr::Error for an unknown name.
@@ -88,6 +94,7 @@ struct ImportOptions {
   Quat rotation;
   Vec3 translation{0, 0, 0};
   float emissionScale = 1.0f;  ///< glTF's emissiveFactor is at most 1: scale it to a light's Le
+  bool importLights = true;    ///< the file's point, spot and directional lights (KHR_lights_punctual)
 };
 
 // A mesh file through assimp (.gltf, .glb, .obj with .mtl, and whatever else assimp reads).

@@ -1,6 +1,7 @@
 // JSON scene files (docs/scene-format.md): mesh files placed in the world, extra quad lights,
 // and the headset rig. Any other path is loaded as a single mesh file, or as a built-in scene.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -104,8 +105,12 @@ Scene loadJsonScene(const std::string& path) {
       for (const json& m : doc["meshes"]) {
         if (!m.is_object() || !m.contains("file") || !m["file"].is_string())
           throw Error("each entry of 'meshes' needs a \"file\"");
-        checkKeys(m, "a mesh entry", {"file", "scale", "rotate_deg", "translate", "emission_scale"});
+        checkKeys(m, "a mesh entry", {"file", "scale", "rotate_deg", "translate", "emission_scale", "import_lights"});
         ImportOptions opt;
+        if (m.contains("import_lights")) {
+          if (!m["import_lights"].is_boolean()) throw Error("mesh import_lights must be true or false");
+          opt.importLights = m["import_lights"].get<bool>();
+        }
         if (m.contains("scale")) opt.scale = vec3(m["scale"], "mesh scale");
         if (m.contains("translate")) opt.translation = vec3(m["translate"], "mesh translate");
         if (m.contains("emission_scale")) opt.emissionScale = number(m["emission_scale"], "mesh emission_scale");
@@ -122,9 +127,44 @@ Scene loadJsonScene(const std::string& path) {
       if (!doc["lights"].is_array()) throw Error("'lights' must be an array");
       for (const json& l : doc["lights"]) {
         if (!l.is_object()) throw Error("each light must be an object");
+        auto angle = [&](const char* key, float fallback) {
+          float deg = l.contains(key) ? number(l[key], std::string("light ") + key) : fallback;
+          if (!(deg >= 0.0f && deg <= 90.0f)) throw Error(std::string("light ") + key + " must be in [0, 90] degrees");
+          return deg * (kPi / 180.0f);
+        };
+        if (l.contains("point") || l.contains("spot") || l.contains("sun")) {
+          PunctualLight p;
+          if (l.contains("point")) {
+            checkKeys(l, "a point light", {"point", "intensity"});
+            p.kind = PunctualKind::Point;
+            p.position = vec3(l["point"], "light point");
+          } else if (l.contains("spot")) {
+            checkKeys(l, "a spot light", {"spot", "direction", "intensity", "inner_deg", "outer_deg"});
+            p.kind = PunctualKind::Spot;
+            p.position = vec3(l["spot"], "light spot");
+            p.direction = vec3(l.value("direction", json::array({0, -1, 0})), "light direction");
+            p.cosInner = std::cos(angle("inner_deg", 0.0f));
+            p.cosOuter = std::cos(angle("outer_deg", 45.0f));
+          } else {
+            checkKeys(l, "a sun", {"sun", "irradiance", "aim_center", "aim_radius"});
+            p.kind = PunctualKind::Directional;
+            p.direction = vec3(l["sun"], "light sun") * -1.0f;  // the file gives the way to the sun
+            if (l.contains("aim_center") != l.contains("aim_radius"))
+              throw Error("a sun's aim needs both aim_center and aim_radius");
+            if (l.contains("aim_center")) {
+              p.position = vec3(l["aim_center"], "sun aim_center");
+              p.aimRadius = number(l["aim_radius"], "sun aim_radius");
+              if (!(p.aimRadius > 0.0f)) throw Error("sun aim_radius must be positive");
+            }
+          }
+          const char* amount = p.kind == PunctualKind::Directional ? "irradiance" : "intensity";
+          p.intensity = vec3(l.value(amount, json::array({1, 1, 1})), std::string("light ") + amount);
+          scene.addPunctualLight(p, l.contains("point") ? "point" : l.contains("spot") ? "spot" : "sun");
+          continue;
+        }
         checkKeys(l, "a light", {"quad", "emission"});
         if (!l.contains("quad") || !l["quad"].is_array() || l["quad"].size() != 4)
-          throw Error("a light needs \"quad\": four corners, counter-clockwise seen from the lit side");
+          throw Error("a light needs \"quad\" (four corners), \"point\", \"spot\" or \"sun\"");
         Material m;
         m.emission = vec3(l.value("emission", json::array({10, 10, 10})), "light emission");
         if (m.emission.x < 0 || m.emission.y < 0 || m.emission.z < 0) throw Error("light emission must not be negative");
@@ -157,6 +197,16 @@ Scene loadScene(const std::string& pathOrBuiltin) {
   Scene scene;
   scene.name = p.stem().string();
   importMeshFile(pathOrBuiltin, scene);
+  if (scene.lightTriangleCount() == 0 && scene.punctualLights().empty() && scene.triangleCount() > 0) {
+    // Most asset-store files carry no light: a sun from above and behind the viewer, so that a
+    // good file renders (JSON scenes say what lights them).
+    PunctualLight sun;
+    sun.kind = PunctualKind::Directional;
+    sun.direction = normalize(Vec3(-0.3f, -1.0f, -0.5f));
+    sun.intensity = Vec3(3.0f);
+    scene.addPunctualLight(sun, "default sun");
+    std::fprintf(stderr, "photonvr: note: '%s' has no light: lit by a default sun (3 W/m^2 from above)\n", pathOrBuiltin.c_str());
+  }
   scene.finalize();
   // A bare mesh file has no camera: look at it from in front (+Z), far enough to see all of it.
   Bounds3 b = scene.bounds();

@@ -8,6 +8,29 @@
 
 namespace pvr {
 
+// A light without area: glTF's KHR_lights_punctual point and spot lights (intensity in W/sr) and
+// a distant (directional) light such as the sun (irradiance in W/m^2 on a surface facing it).
+enum class PunctualKind : uint32_t { Point = 0, Spot = 1, Directional = 2 };
+
+struct PunctualLight {
+  PunctualKind kind = PunctualKind::Point;
+  Vec3 position{0, 0, 0};
+  Vec3 direction{0, -1, 0};  ///< unit, the way the light travels (spot axis, sun rays)
+  Vec3 intensity{1, 1, 1};   ///< W/sr (point, spot) or W/m^2 (directional)
+  float cosInner = 1.0f, cosOuter = 0.0f;  ///< spot cone: full inside inner, none outside outer
+  // A distant light's photons cross a disk of this radius around `position`, facing the light
+  // (an opening the light comes through, e.g. a courtyard's roof); 0: the scene's bounding sphere.
+  float aimRadius = 0.0f;
+
+  // glTF's spot falloff: a smooth step from the outer to the inner cone, squared.
+  PVR_HOST_DEVICE float falloff(float cosAngle) const {
+    if (kind != PunctualKind::Spot) return 1.0f;
+    float scale = 1.0f / fmaxf(1e-3f, cosInner - cosOuter);
+    float t = fminf(fmaxf((cosAngle - cosOuter) * scale, 0.0f), 1.0f);
+    return t * t;
+  }
+};
+
 // Local geometry at a hit.
 struct SurfacePoint {
   Vec3 position;
@@ -28,9 +51,15 @@ struct SceneView {
   const TextureView* textures = nullptr;
   uint32_t textureCount = 0;
   const uint32_t* lightTriangles = nullptr;
-  const float* lightCdf = nullptr;  ///< lightCount + 1 entries, weights luminance(Le) * area
-  uint32_t lightCount = 0;
-  float sceneRadius = 1.0f;  ///< scales ray offsets
+  // lightCount + 1 entries over the emitting triangles, then the punctual lights, weighted by
+  // power / pi: luminance(Le) * area for a triangle, 4 I for a point light, ...
+  const float* lightCdf = nullptr;
+  uint32_t lightCount = 0;           ///< triangleLightCount + punctualCount
+  uint32_t triangleLightCount = 0;
+  const PunctualLight* punctualLights = nullptr;
+  uint32_t punctualCount = 0;
+  float sceneRadius = 1.0f;  ///< scales ray offsets; the bounding sphere's radius
+  Vec3 sceneCenter{0, 0, 0};
 
   PVR_HOST_DEVICE const Material& material(uint32_t prim) const { return materials[materialIds[prim]]; }
 
@@ -124,28 +153,103 @@ struct SceneView {
   PVR_HOST_DEVICE float rayEpsilon() const { return 1e-4f * sceneRadius; }
 };
 
-// A point sampled on the lights.
+// A point sampled on the lights (area lights), or a punctual light chosen.
 struct LightSample {
   Vec3 position;
-  Vec3 normal;    ///< front face
-  Vec3 emission;  ///< Le
-  float pdfArea;  ///< probability density per unit area over all light surfaces
+  Vec3 normal;    ///< area: front face
+  Vec3 emission;  ///< area: Le; punctual: I (W/sr) or E (W/m^2)
+  float pdfArea;  ///< area: probability density per unit area over all light surfaces
+  float pick = 1.0f;  ///< probability of choosing this light
+  int punctual = -1;  ///< index into punctualLights, or -1 for an area light
 };
 
 PVR_HOST_DEVICE inline LightSample sampleLight(const SceneView& s, float uPick, float u1, float u2) {
   int i = sampleDiscreteCdf(s.lightCdf, int(s.lightCount), uPick);
+  float pick = (s.lightCdf[i + 1] - s.lightCdf[i]) / s.lightCdf[s.lightCount];
+  LightSample ls;
+  ls.pick = pick;
+  if (uint32_t(i) >= s.triangleLightCount) {
+    ls.punctual = i - int(s.triangleLightCount);
+    const PunctualLight& l = s.punctualLights[ls.punctual];
+    ls.position = l.position;
+    ls.normal = l.direction;
+    ls.emission = l.intensity;
+    ls.pdfArea = 0.0f;
+    return ls;
+  }
+  uint32_t prim = s.lightTriangles[i];
+  Vec3 a, b, c;
+  s.triangle(prim, a, b, c);
+  Vec2 bc = sampleTriangleBarycentrics(u1, u2);
+  float area = 0.5f * length(cross(b - a, c - a));
+  ls.position = a * (1.0f - bc.x - bc.y) + b * bc.x + c * bc.y;
+  ls.normal = s.faceNormal(prim, a, b, c);
+  ls.emission = s.material(prim).emission;
+  ls.pdfArea = pick / area;
+  return ls;
+}
+
+// An area light sample for direct lighting: a triangle chosen among the emitting triangles alone
+// (punctual lights are each evaluated exactly, so they need no sampling). With no punctual
+// lights this is sampleLight.
+PVR_HOST_DEVICE inline LightSample sampleAreaLight(const SceneView& s, float uPick, float u1, float u2) {
+  int i = sampleDiscreteCdf(s.lightCdf, int(s.triangleLightCount), uPick);
+  float pick = (s.lightCdf[i + 1] - s.lightCdf[i]) / s.lightCdf[s.triangleLightCount];
   uint32_t prim = s.lightTriangles[i];
   Vec3 a, b, c;
   s.triangle(prim, a, b, c);
   Vec2 bc = sampleTriangleBarycentrics(u1, u2);
   float area = 0.5f * length(cross(b - a, c - a));
   LightSample ls;
+  ls.pick = pick;
   ls.position = a * (1.0f - bc.x - bc.y) + b * bc.x + c * bc.y;
   ls.normal = s.faceNormal(prim, a, b, c);
   ls.emission = s.material(prim).emission;
-  float pick = (s.lightCdf[i + 1] - s.lightCdf[i]) / s.lightCdf[s.lightCount];
   ls.pdfArea = pick / area;
   return ls;
+}
+
+// What a punctual light sends to a point: the direction to it, how far a shadow ray must go
+// (INFINITY for a distant light) and the irradiance on a surface facing it, already divided by
+// the probability of having chosen the light.
+struct PunctualIllumination {
+  Vec3 wi{0, 0, 0};
+  float shadowDistance = 0.0f;
+  Vec3 irradiance{0, 0, 0};
+};
+
+PVR_HOST_DEVICE inline PunctualIllumination illuminate(const SceneView& s, const LightSample& ls, Vec3 p, float eps) {
+  const PunctualLight& l = s.punctualLights[ls.punctual];
+  PunctualIllumination out;
+  if (l.kind == PunctualKind::Directional) {
+    out.wi = -l.direction;
+    out.shadowDistance = INFINITY;
+    out.irradiance = l.intensity * (1.0f / ls.pick);
+    return out;
+  }
+  Vec3 toLight = l.position - p;
+  float dist2 = lengthSquared(toLight);
+  if (!(dist2 > 0.0f)) return out;
+  float dist = sqrtf(dist2);
+  out.wi = toLight / dist;
+  out.shadowDistance = dist * (1.0f - 1e-3f) - eps;
+  out.irradiance = l.intensity * (l.falloff(-dot(out.wi, l.direction)) / (dist2 * ls.pick));
+  return out;
+}
+
+// The power a punctual light emits (W): 4 pi I, the spot's falloff integrated over its cone, or
+// E times the scene's cross-section for a distant light.
+PVR_HOST_DEVICE inline Vec3 punctualPower(const PunctualLight& l, float sceneRadius) {
+  if (l.kind == PunctualKind::Directional) {
+    float r = l.aimRadius > 0.0f ? l.aimRadius : sceneRadius;
+    return l.intensity * (kPi * r * r);
+  }
+  if (l.kind == PunctualKind::Point) return l.intensity * (4.0f * kPi);
+  // 2 pi times the integral of the falloff over cos(angle) from cosOuter to 1 (midpoint rule).
+  const int n = 256;
+  float sum = 0.0f, step = (1.0f - l.cosOuter) / float(n);
+  for (int k = 0; k < n; ++k) sum += l.falloff(l.cosOuter + (float(k) + 0.5f) * step);
+  return l.intensity * (2.0f * kPi * sum * step);
 }
 
 }  // namespace pvr
