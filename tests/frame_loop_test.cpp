@@ -112,20 +112,21 @@ TEST(FrameLoop, PacedSlotsAreOnePeriodApartAndSlowFramesMissTheirDeadline) {
   renderer.rig().width = 8, renderer.rig().height = 8;
   renderer.options().photonsX = renderer.options().photonsY = 8;
   OffscreenOptions oo;
-  oo.refreshHz = 50.0;  // 20 ms slots
+  oo.refreshHz = 10.0;  // 100 ms slots: an 8x8 frame fits many times over, even on a loaded machine
   oo.paced = true;
   int calls = 0;
   oo.handOver = [&](const PresentedFrame&) {
-    if (++calls == 3) std::this_thread::sleep_for(std::chrono::milliseconds(45));  // one slow frame
+    if (++calls == 3) std::this_thread::sleep_for(std::chrono::milliseconds(250));  // one slow frame
   };
   OffscreenPresenter presenter(renderer.rig(), {}, oo);
   FrameLoopOptions lo;
-  lo.maxFrames = 6;
+  lo.maxFrames = 5;
   FrameStats stats = FrameLoop(renderer, presenter).run(lo);
-  ASSERT_EQ(stats.frames(), 6u);
-  EXPECT_EQ(stats.missedDeadlines(), 1u);
+  ASSERT_EQ(stats.frames(), 5u);
   EXPECT_TRUE(stats.records()[2].missedDeadline);
-  EXPECT_NEAR(stats.records()[1].intervalMs, 20.0, 8.0);
+  EXPECT_LT(stats.records()[2].slackMs, -100.0);
+  EXPECT_GE(stats.missedDeadlines(), 1u);
+  for (size_t i = 1; i < 3; ++i) EXPECT_GE(stats.records()[i].intervalMs, 99.0);  // paced: never before its slot
 }
 
 TEST(OffscreenPresenter, RejectsABadRefreshRate) {

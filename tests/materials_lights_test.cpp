@@ -1,0 +1,276 @@
+// Textures, alpha cut-outs and lights without area, against exact expectations: texel lookups,
+// wrap modes and the mip chain; the ray cone's level of detail on a plane; a cut-out quad's shadow
+// on both intersectors (Embree's filter and the GPU BVH's any-hit, run on the host); a point
+// light's inverse-square cosine irradiance (direct exactly, the photon map within its noise); a
+// spot's cone edges; a distant light's E cos; the photons carry the lights' power.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pvr/accel/bvh_traversal.h"
+#include "pvr/cpu/cpu_backend.h"
+#include "pvr/photon/gather.h"
+#include "pvr/photon/hash_grid.h"
+#include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+
+uint32_t rgba(uint8_t r, uint8_t g, uint8_t b, uint8_t a = 255) { return r | g << 8 | b << 16 | uint32_t(a) << 24; }
+
+// A 4x4 texture whose texel (x, y) has R = 16 x + 1, G = 16 y + 2, B = 200, A = 60 x.
+Scene checkerScene(WrapMode s, WrapMode t) {
+  Scene scene;
+  std::vector<uint32_t> texels;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) texels.push_back(rgba(uint8_t(16 * x + 1), uint8_t(16 * y + 2), 200, uint8_t(60 * x)));
+  scene.addTexture("checker", 4, 4, texels, false, s, t);
+  return scene;
+}
+
+TEST(Textures, TexelCentresReturnTheTexelExactly) {
+  Scene scene = checkerScene(WrapMode::Repeat, WrapMode::Repeat);
+  const TextureView& t = scene.textureViews()[0];
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      Rgba c = sampleTexture(t, {(x + 0.5f) / 4.0f, (y + 0.5f) / 4.0f}, 0.0f);
+      EXPECT_FLOAT_EQ(c.rgb.x, (16 * x + 1) / 255.0f);
+      EXPECT_FLOAT_EQ(c.rgb.y, (16 * y + 2) / 255.0f);
+      EXPECT_FLOAT_EQ(c.rgb.z, 200 / 255.0f);
+      EXPECT_FLOAT_EQ(c.a, (60 * x) / 255.0f);
+    }
+}
+
+TEST(Textures, WrapModes) {
+  auto red = [](const Scene& s, float u) { return sampleTexture(s.textureViews()[0], {u, 0.125f}, 0.0f).rgb.x * 255.0f; };
+  Scene repeat = checkerScene(WrapMode::Repeat, WrapMode::Repeat);
+  Scene clamp = checkerScene(WrapMode::ClampToEdge, WrapMode::ClampToEdge);
+  Scene mirror = checkerScene(WrapMode::MirroredRepeat, WrapMode::MirroredRepeat);
+  EXPECT_FLOAT_EQ(red(repeat, 1.125f), 1.0f);      // texel 0 again
+  EXPECT_FLOAT_EQ(red(repeat, -0.625f), 17.0f);    // 0.375: texel 1
+  EXPECT_FLOAT_EQ(red(clamp, -3.0f), 1.0f);        // the edge texel
+  EXPECT_FLOAT_EQ(red(clamp, 7.5f), 49.0f);
+  EXPECT_FLOAT_EQ(red(mirror, 1.125f), 49.0f);     // mirrored: texel 3
+  EXPECT_FLOAT_EQ(red(mirror, 1.875f), 1.0f);      // texel 0
+  EXPECT_FLOAT_EQ(red(mirror, -0.125f), 1.0f);
+  EXPECT_EQ(wrapTexel(-1, 4, WrapMode::MirroredRepeat), 0);  // 0 1 2 3 | 3 2 1 0 | 0 1 ...
+  EXPECT_EQ(wrapTexel(5, 4, WrapMode::MirroredRepeat), 2);
+  EXPECT_EQ(wrapTexel(9, 4, WrapMode::MirroredRepeat), 1);
+}
+
+TEST(Textures, MipChainAveragesInLinearLight) {
+  Scene scene;
+  // 2x2 black and white sRGB texels: the next level is their average in linear light, 0.5,
+  // which sRGB encodes as 188.
+  scene.addTexture("bw", 2, 2, {rgba(0, 0, 0), rgba(255, 255, 255), rgba(255, 255, 255), rgba(0, 0, 0)}, true);
+  const TextureView& t = scene.textureViews()[0];
+  ASSERT_EQ(t.levels, 2);
+  EXPECT_EQ(t.texels[t.levelOffset[1]] & 255u, 188u);
+  EXPECT_NEAR(sampleTexture(t, {0.3f, 0.7f}, 1.0f).rgb.x, 0.5f, 0.003f);
+  // Half-way between the levels: the blend of both.
+  float l0 = sampleTexture(t, {0.25f, 0.25f}, 0.0f).rgb.x, l1 = sampleTexture(t, {0.25f, 0.25f}, 1.0f).rgb.x;
+  EXPECT_FLOAT_EQ(sampleTexture(t, {0.25f, 0.25f}, 0.5f).rgb.x, 0.5f * (l0 + l1));
+  EXPECT_THROW(scene.addTexture("bad", 3, 3, {rgba(0, 0, 0)}, true), Error);
+}
+
+TEST(Textures, TransformFollowsGltf) {
+  TextureRef ref;
+  ref.offset = {0.5f, 0.25f};
+  ref.scale = {2.0f, 3.0f};
+  ref.rotation = 0.5f * kPi;  // glTF: u' = cos*su + sin*sv + tx, v' = -sin*su + cos*sv + ty
+  Vec2 uv = ref.transform({0.1f, 0.2f});
+  EXPECT_NEAR(uv.x, 0.6f + 0.5f, 1e-6f);
+  EXPECT_NEAR(uv.y, -0.2f + 0.25f, 1e-6f);
+}
+
+// A unit quad on z = 0 facing +Z with UVs 0..1 and a 256x256 texture.
+Scene texturedPlane(int size) {
+  Scene scene;
+  std::vector<uint32_t> texels(size_t(size) * size, rgba(128, 128, 128));
+  Material m;
+  m.baseColorTexture.texture = int32_t(scene.addTexture("grey", size, size, texels, true));
+  uint32_t id = scene.addMaterial(m, "plane");
+  std::vector<Vec2> uvs[2] = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {}};
+  scene.addMesh("plane", {{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}}, {}, uvs, {0, 1, 2, 0, 2, 3}, id);
+  PunctualLight sun;
+  sun.kind = PunctualKind::Directional;
+  sun.direction = {0, 0, -1};
+  scene.addPunctualLight(sun, "sun");
+  scene.finalize();
+  return scene;
+}
+
+TEST(Textures, RayConeChoosesTheExpectedLevel) {
+  Scene scene = texturedPlane(256);
+  SceneView v = scene.view();
+  const TextureRef& ref = scene.materials()[0].baseColorTexture;
+  // A cone as wide as one texel (1/256 m) seen head on is level 0; each doubling one level up;
+  // a 60 degree slant widens it by 1 / cos.
+  EXPECT_NEAR(v.textureLod(ref, 0, 1.0f / 256.0f, 1.0f), 0.0f, 1e-4f);
+  EXPECT_NEAR(v.textureLod(ref, 0, 4.0f / 256.0f, 1.0f), 2.0f, 1e-4f);
+  EXPECT_NEAR(v.textureLod(ref, 0, 1.0f / 256.0f, 0.5f), 1.0f, 1e-4f);
+  // Through a camera: a pixel's footprint at distance d is d * pixelSpread.
+  EyeCamera cam;
+  cam.width = cam.height = 512;
+  cam.fov = {-0.5f, 0.5f, 0.5f, -0.5f};
+  float d = 2.0f, expected = 8.0f + std::log2(d * cam.pixelSpread());
+  EXPECT_NEAR(v.textureLod(ref, 1, d * cam.pixelSpread(), 1.0f), expected, 1e-4f);
+}
+
+// A floor at y = 0, a quad at y = 0.5 whose texture's left half (u < 0.5) is cut out, and a
+// shadow ray from each floor point straight up: blocked exactly where the quad is opaque.
+TEST(Alpha, CutOutTexelsCastNoShadowOnBothIntersectors) {
+  Scene scene;
+  std::vector<uint32_t> texels;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) texels.push_back(rgba(200, 200, 200, x < 4 ? 0 : 255));
+  Material cut;
+  cut.baseColorTexture.texture = int32_t(scene.addTexture("mask", 8, 8, texels, true, WrapMode::ClampToEdge, WrapMode::ClampToEdge));
+  cut.alphaMode = AlphaMode::Mask;
+  uint32_t cutId = scene.addMaterial(cut, "cut");
+  uint32_t floorId = scene.addMaterial(Material{}, "floor");
+  std::vector<Vec2> uvs[2] = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {}};
+  scene.addMesh("quad", {{-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}, {-0.5f, 0.5f, 0.5f}}, {}, uvs,
+                {0, 2, 1, 0, 3, 2}, cutId);
+  scene.addMesh("floor", {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}}, {}, {0, 2, 1, 0, 3, 2}, floorId);
+  PunctualLight lamp;
+  lamp.position = {0, 3, 0};
+  scene.addPunctualLight(lamp, "lamp");
+  scene.finalize();
+  ASSERT_TRUE(scene.hasAlphaTestedMaterial());
+  EmbreeIntersector embree(scene);
+  Bvh bvh = Bvh::build(scene);
+  BvhIntersector ours{bvh.view()};
+  ours.alphaTest = true;
+  ours.alphaScene = scene.view();
+  int blocked = 0;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      float x = -0.6f + 1.2f * (i + 0.5f) / 40.0f, z = -0.6f + 1.2f * (j + 0.5f) / 40.0f;
+      Ray up{{x, 1e-3f, z}, {0, 1, 0}};
+      bool expected = x > 0.0f && x < 0.5f && z > -0.5f && z < 0.5f;  // over the opaque half
+      EXPECT_EQ(embree.occluded(up, 2.0f), expected) << x << " " << z;
+      EXPECT_EQ(ours.occluded(up, 2.0f), expected) << x << " " << z;
+      Hit a, b;
+      embree.intersect(up, 2.0f, a);
+      ours.intersect(up, 2.0f, b);
+      EXPECT_EQ(a.valid(), expected);
+      EXPECT_EQ(b.valid(), expected);
+      blocked += expected;
+    }
+  EXPECT_GT(blocked, 100);
+}
+
+// A white diffuse floor (albedo 1) under one light; the radiance towards the eye at floor point
+// p is (1 / pi) E(p), E the irradiance. Direct light is exact: every punctual light is evaluated.
+struct LitFloor {
+  Scene scene;
+  explicit LitFloor(const PunctualLight& light) {
+    Material white;
+    white.albedo = {1, 1, 1};
+    uint32_t id = scene.addMaterial(white, "floor");
+    scene.addMesh("floor", {{-4, 0, -4}, {4, 0, -4}, {4, 0, 4}, {-4, 0, 4}}, {}, {0, 2, 1, 0, 3, 2}, id);
+    scene.addPunctualLight(light, "light");
+    scene.finalize();
+  }
+  Vec3 directRadiance(const EmbreeIntersector& intersector, Vec3 p) const {
+    GatherParams params;
+    Ray down{p + Vec3(0, 1.0f, 0.3f), normalize(Vec3(0, -1.0f, -0.3f))};
+    CounterRng rng(1, 0, 0);
+    return traceToDiffuse(scene.view(), intersector, params, down, rng).radiance;
+  }
+};
+
+TEST(Lights, PointLightIsInverseSquareTimesCosine) {
+  PunctualLight lamp;
+  lamp.position = {0.3f, 2.0f, -0.2f};
+  lamp.intensity = {10, 5, 2};
+  LitFloor floor(lamp);
+  EmbreeIntersector intersector(floor.scene);
+  for (Vec3 p : {Vec3(0.3f, 0, -0.2f), Vec3(1.5f, 0, 0.5f), Vec3(-2.0f, 0, 1.0f)}) {
+    Vec3 toLight = lamp.position - p;
+    float r2 = lengthSquared(toLight), cosTheta = toLight.y / std::sqrt(r2);
+    Vec3 L = floor.directRadiance(intersector, p);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(L[c], lamp.intensity[c] * cosTheta / r2 / kPi, 1e-4f * L[c] + 1e-7f);
+  }
+}
+
+TEST(Lights, SpotConeEdges) {
+  PunctualLight spot;
+  spot.kind = PunctualKind::Spot;
+  spot.position = {0, 2, 0};
+  spot.direction = {0, -1, 0};
+  spot.intensity = {8, 8, 8};
+  spot.cosInner = std::cos(0.3f), spot.cosOuter = std::cos(0.5f);
+  LitFloor floor(spot);
+  EmbreeIntersector intersector(floor.scene);
+  auto at = [&](float angle) { return floor.directRadiance(intersector, {2.0f * std::tan(angle), 0, 0}).x; };
+  auto full = [&](float angle) {  // inside the inner cone: I cos / r^2 / pi
+    float r = 2.0f / std::cos(angle);
+    return 8.0f * std::cos(angle) / (r * r) / kPi;
+  };
+  EXPECT_NEAR(at(0.0f), full(0.0f), 1e-4f);
+  EXPECT_NEAR(at(0.29f), full(0.29f), 1e-4f);
+  EXPECT_EQ(at(0.51f), 0.0f);
+  float mid = at(0.4f);  // between the cones: glTF's smooth falloff, strictly between
+  EXPECT_GT(mid, 0.0f);
+  EXPECT_LT(mid, full(0.4f));
+}
+
+TEST(Lights, DistantLightIsIrradianceTimesCosine) {
+  PunctualLight sun;
+  sun.kind = PunctualKind::Directional;
+  sun.direction = normalize(Vec3(0.6f, -0.8f, 0.0f));  // cos = 0.8 on the floor
+  sun.intensity = {5, 4, 3};
+  LitFloor floor(sun);
+  EmbreeIntersector intersector(floor.scene);
+  Vec3 L = floor.directRadiance(intersector, {0.5f, 0, 0.5f});
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(L[c], sun.intensity[c] * 0.8f / kPi, 1e-5f);
+}
+
+// The photon map alone (all photons stored) estimates the same irradiance, within its noise.
+TEST(Lights, PhotonMapAgreesWithTheDirectIrradiance) {
+  PunctualLight lamp;
+  lamp.position = {0, 1.5f, 0};
+  lamp.intensity = {20, 20, 20};
+  LitFloor floor(lamp);
+  CpuBackend backend(floor.scene);
+  PhotonTraceParams tp;
+  tp.photonCount = 1u << 20;
+  tp.storeDirect = true;
+  tp.maxDepth = 1;
+  std::vector<Photon> photons = backend.tracePhotons(tp);
+  HashGrid grid = HashGrid::build(photons, 0.1f);
+  DensityParams dp;
+  dp.radius = 0.1f;
+  for (Vec3 p : {Vec3(0, 0, 0), Vec3(0.8f, 0, -0.3f)}) {
+    Vec3 toLight = lamp.position - p;
+    float r2 = lengthSquared(toLight), expected = 20.0f * (toLight.y / std::sqrt(r2)) / r2;
+    float estimate = estimateFluxDensity(grid.view(), p, {0, 1, 0}, dp).x;
+    EXPECT_NEAR(estimate, expected, 0.05f * expected) << p.x;
+  }
+}
+
+TEST(Lights, PhotonsCarryTheLightsPower) {
+  Scene scene;
+  uint32_t id = scene.addMaterial(Material{}, "floor");
+  scene.addMesh("floor", {{-4, 0, -4}, {4, 0, -4}, {4, 0, 4}, {-4, 0, 4}}, {}, {0, 2, 1, 0, 3, 2}, id);
+  PunctualLight point, sun;
+  point.position = {0, 1, 0};
+  point.intensity = {3, 2, 1};
+  sun.kind = PunctualKind::Directional;
+  sun.intensity = {1, 1, 1};
+  scene.addPunctualLight(point, "point");
+  scene.addPunctualLight(sun, "sun");
+  scene.finalize();
+  PhotonTraceParams tp;
+  tp.photonCount = 200000;
+  Vec3 sum{0, 0, 0};
+  for (uint32_t i = 0; i < tp.photonCount; ++i) sum += emitPhoton(scene.view(), tp, i).power;
+  Vec3 total = scene.totalLightPower();
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], total[c], 0.01f * total[c]);
+}
+
+}  // namespace
+}  // namespace pvr
