@@ -322,3 +322,71 @@ TEST(GpuBackend, RayTraversalAgreesWithEmbree) {
 
 }  // namespace
 }  // namespace pvr
+
+namespace pvr {
+namespace {
+
+// The Cornell box with a textured, alpha-cut quad (a checker whose every fourth texel is cut out,
+// repeated three times, trilinear under the ray cone), a point light, a spot and a sun aimed
+// into the open front: the GPU must trace the same photons and render the same images.
+Scene texturedLitCornell() {
+  Scene scene = builtinScene("cornell");
+  std::vector<uint32_t> texels;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      bool dark = ((x / 8) + (y / 8)) % 2;
+      bool cut = (x / 8) % 4 == 3 && (y / 8) % 4 == 1;
+      texels.push_back(dark ? 0xff203050u : (cut ? 0x00e0e0e0u : 0xffd0c0b0u));
+    }
+  Material m;
+  m.baseColorTexture.texture = int32_t(scene.addTexture("checker", 64, 64, texels, true));
+  m.alphaMode = AlphaMode::Mask;
+  uint32_t id = scene.addMaterial(m, "checker");
+  std::vector<Vec2> uvs[2] = {{{0, 0}, {3, 0}, {3, 3}, {0, 3}}, {}};
+  scene.addMesh("panel", {{-0.35f, 0.15f, -0.45f}, {0.35f, 0.15f, -0.45f}, {0.35f, 0.85f, -0.3f}, {-0.35f, 0.85f, -0.3f}}, {},
+                uvs, {0, 1, 2, 0, 2, 3}, id);
+  PunctualLight point, spot, sun;
+  point.position = {0.2f, 0.6f, 0.1f};
+  point.intensity = {0.4f, 0.35f, 0.3f};
+  spot.kind = PunctualKind::Spot;
+  spot.position = {-0.3f, 0.9f, 0.2f};
+  spot.direction = {0.2f, -1, -0.3f};
+  spot.intensity = {1.5f, 1.5f, 1.5f};
+  spot.cosInner = std::cos(0.3f), spot.cosOuter = std::cos(0.6f);
+  sun.kind = PunctualKind::Directional;
+  sun.direction = {0.1f, -0.4f, -1.0f};
+  sun.intensity = {1, 1, 1};
+  sun.position = {0, 0.5f, 0};
+  sun.aimRadius = 0.6f;
+  scene.addPunctualLight(point, "point");
+  scene.addPunctualLight(spot, "spot");
+  scene.addPunctualLight(sun, "sun");
+  scene.finalize();
+  return scene;
+}
+
+TEST(GpuBackend, TexturesAlphaAndPunctualLightsMatchTheCpu) {
+  PVR_REQUIRE_GPU();
+  Scene scene = texturedLitCornell();
+  StereoRig rig = scene.rig;
+  rig.width = 160, rig.height = 176;
+  FrameRenderer cpu(makeCpuFrameRenderer(scene)), gpu(makeCudaFrameRenderer(scene));
+  for (ShadingMode mode : {ShadingMode::Full, ShadingMode::PhotonMapOnly}) {
+    RenderOptions o = comparisonOptions();
+    o.gather.mode = mode;
+    FrameResult reference = cpu.render(rig, o);
+    for (DensityKernel kernel : {DensityKernel::Single, DensityKernel::Hybrid}) {
+      o.kernel = kernel;
+      FrameResult frame = gpu.render(rig, o);
+      ImageCheck c = compare(reference, frame);
+      std::string what = std::string(densityKernelName(kernel)) + (mode == ShadingMode::Full ? " full" : " photons");
+      EXPECT_EQ(frame.storedPhotons, reference.storedPhotons) << what;
+      EXPECT_LT(c.relativeMad, 0.01) << what;
+      EXPECT_LT(c.outliers, 0.005) << what;
+      EXPECT_GT(c.firstPrimAgree, 0.995) << what;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pvr

@@ -14,7 +14,7 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   indices.upload(host.indices, 3 * size_t(host.triangleCount), "scene indices");
   materialIds.upload(host.materialIds, host.triangleCount, "material ids");
   materials.upload(scene.materials().data(), scene.materials().size(), "materials");
-  lightTriangles.upload(host.lightTriangles, host.lightCount, "light triangles");
+  lightTriangles.upload(host.lightTriangles, host.triangleLightCount, "light triangles");
   lightCdf.upload(host.lightCdf, size_t(host.lightCount) + 1, "light CDF");
   if (host.punctualCount) punctualLights.upload(host.punctualLights, host.punctualCount, "punctual lights");
   for (int set = 0; set < 2; ++set)

@@ -2,6 +2,7 @@
 // and the headset rig. Any other path is loaded as a single mesh file, or as a built-in scene.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,27 @@
 
 namespace pvr {
 namespace {
+
+// "${NAME}/x" with NAME from the environment: scene files that refer to meshes we may not ship
+// (the classic scenes' licences) name their folder by a variable the user sets.
+std::string expandEnvironment(const std::string& text) {
+  std::string out;
+  for (size_t i = 0; i < text.size();) {
+    if (text.compare(i, 2, "${") == 0) {
+      size_t end = text.find('}', i + 2);
+      if (end == std::string::npos) throw Error("unterminated ${...} in '" + text + "'");
+      std::string name = text.substr(i + 2, end - i - 2);
+      const char* value = std::getenv(name.c_str());
+      if (!value || !*value) throw Error("the mesh path '" + text + "' needs the environment variable " + name + " (not set)");
+      out += value;
+      i = end + 1;
+    } else {
+      out += text[i++];
+    }
+  }
+  return out;
+}
+
 
 using nlohmann::json;
 
@@ -119,7 +141,7 @@ Scene loadJsonScene(const std::string& path) {
           opt.rotation = Quat::fromAxisAngle({0, 0, 1}, r.z) * Quat::fromAxisAngle({0, 1, 0}, r.y) *
                          Quat::fromAxisAngle({1, 0, 0}, r.x);
         }
-        std::filesystem::path file = m["file"].get<std::string>();
+        std::filesystem::path file = expandEnvironment(m["file"].get<std::string>());
         importMeshFile((file.is_absolute() ? file : dir / file).string(), scene, opt);
       }
     }
