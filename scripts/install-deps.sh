@@ -8,7 +8,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libstb-dev libopenexr-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libvulkan-dev mesa-vulkan-drivers libopenxr-dev libglfw3-dev libimgui-dev
-  xvfb xauth
+  xvfb xauth assimp-testmodels
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -65,7 +65,7 @@ void ensureParentDirectory(const std::string& file) {
 struct RenderArgs {
   std::string scene = "cornell";
   std::string photons = "256x256";
-  std::string radius = "0.05";
+  std::string radius;  // empty: 0.05 for the built-in scenes, else 0.4 % of the scene's bounding-box diagonal
   std::string map = "hashgrid";
   std::string estimator = "radius";
   std::string kernel = "hybrid";
@@ -153,7 +153,9 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
 void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--photons", a.photons, "Emitted photons as WxH (the paper's 128x128 .. 512x512) or a count")
       ->capture_default_str();
-  cmd.add_option("--radius", a.radius, "Search radius of density estimation (the maximum radius for kNN), scene units")
+  cmd.add_option("--radius", a.radius,
+                 "Search radius of density estimation (the maximum radius for kNN), scene units (default: 0.05 for the "
+                 "built-in scenes, 0.4% of the bounding-box diagonal for others)")
       ->capture_default_str();
   cmd.add_option("--map", a.map, "Photon map: hashgrid | kdtree")->capture_default_str();
   cmd.add_option("--estimator", a.estimator, "Density estimation: radius (fixed radius, no heap) | knn (max-heap)")
@@ -181,7 +183,7 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
     throw Error("--photons: too many photons: '" + a.photons + "' (at most " + std::to_string(kMaxPhotons) + ", 8192x8192)");
   o.photonsX = uint32_t(photons.x);
   o.photonsY = uint32_t(photons.y);
-  o.gather.density.radius = parseFloat(a.radius, "--radius");
+  o.gather.density.radius = a.radius.empty() ? 0.05f : parseFloat(a.radius, "--radius");
   if (a.map == "hashgrid") o.map = PhotonMapKind::HashGrid;
   else if (a.map == "kdtree") o.map = PhotonMapKind::KdTree;
   else throw Error("--map must be hashgrid or kdtree, got '" + a.map + "'");
@@ -235,6 +237,11 @@ std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
   if (a.head) rig.head = *a.head;
   RenderOptions& options = setup->options;
   options = toOptions(a, rig);
+  const std::vector<std::string> builtins = builtinSceneNames();
+  if (a.radius.empty() && std::find(builtins.begin(), builtins.end(), a.scene) == builtins.end()) {
+    Bounds3 b = scene.bounds();  // a scene of any size: the radius follows it
+    options.gather.density.radius = std::max(0.004f * length(b.extent()), 1e-6f);
+  }
   FoveationMask& mask = setup->mask;
   if (a.acuity != "linear" && a.acuity != "geisler-perry")
     throw Error("--acuity must be linear or geisler-perry, got '" + a.acuity + "'");
