@@ -274,3 +274,90 @@ TEST(Lights, PhotonsCarryTheLightsPower) {
 
 }  // namespace
 }  // namespace pvr
+
+#include <filesystem>
+#include <algorithm>
+#include <fstream>
+#include <unistd.h>
+
+#include "pvr/image/image_io.h"
+
+namespace pvr {
+namespace {
+
+// An OBJ with map_Kd and map_d next to it: both images load, the material is a cut-out, and a hit
+// reads the texels (colour in the right half, cut out in the left half of the mask).
+TEST(SceneImport, ObjTextureAndAlphaMapsLoad) {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / ("pvr_obj_maps_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::vector<unsigned char> colour(8 * 8 * 3), mask(8 * 8 * 3);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      unsigned char* c = &colour[3 * (y * 8 + x)];
+      c[0] = 200, c[1] = uint8_t(20 * x), c[2] = uint8_t(20 * y);
+      unsigned char* m = &mask[3 * (y * 8 + x)];
+      m[0] = m[1] = m[2] = x < 4 ? 0 : 255;
+    }
+  writePngRgb(colour, 8, 8, (dir / "Colour.png").string());
+  writePngRgb(mask, 8, 8, (dir / "mask.png").string());
+  std::ofstream(dir / "quad.mtl") << "newmtl leaf\nKd 1 1 1\nd 1\nmap_Kd colour.png\nmap_d mask.png\n";  // case differs: found anyway
+  std::ofstream(dir / "quad.obj") << "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                     "usemtl leaf\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  Scene scene;
+  importMeshFile((dir / "quad.obj").string(), scene);
+  PunctualLight sun;
+  sun.kind = PunctualKind::Directional;
+  scene.addPunctualLight(sun, "sun");
+  scene.finalize();
+  fs::remove_all(dir);
+  ASSERT_EQ(scene.textureCount(), 2u);
+  const auto& names = scene.materialNames();
+  size_t leaf = size_t(std::find(names.begin(), names.end(), "leaf") - names.begin());
+  ASSERT_LT(leaf, names.size());
+  const Material& m = scene.materials()[leaf];
+  ASSERT_TRUE(m.baseColorTexture.present());
+  ASSERT_TRUE(m.opacityTexture.present());
+  EXPECT_EQ(m.alphaMode, AlphaMode::Mask);
+  SceneView v = scene.view();
+  // Triangle 0 is (0,0) (1,0) (1,1) in UV: barycentrics (u, v) = weights of vertices 1 and 2.
+  // A point at UV (0.8, 0.3) is opaque; (0.2, 0.1) is cut out.
+  EXPECT_TRUE(v.alphaPasses(0, 0.5f, 0.3f));   // uv = (0.8, 0.3)
+  EXPECT_FALSE(v.alphaPasses(0, 0.1f, 0.1f));  // uv = (0.2, 0.1)
+  Vec3 albedo = v.albedoAt(m, 0, 0.5f, 0.3f);
+  EXPECT_NEAR(albedo.x, srgb8ToLinear(200), 0.02f);
+}
+
+}  // namespace
+}  // namespace pvr
+
+namespace pvr {
+namespace {
+
+// KHR_texture_transform from the Khronos sample (Debian's assimp-testmodels), read from the
+// file's JSON and matched to assimp's reordered materials by name.
+TEST(SceneImport, GltfTextureTransformIsRead) {
+  const std::string path = "/usr/share/assimp/models/glTF2/textureTransform/TextureTransformTest.gltf";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "assimp-testmodels is not installed";
+  Scene scene;
+  importMeshFile(path, scene);
+  auto material = [&](const std::string& name) -> const Material& {
+    const auto& names = scene.materialNames();
+    size_t i = size_t(std::find(names.begin(), names.end(), name) - names.begin());
+    EXPECT_LT(i, names.size()) << name;
+    return scene.materials()[std::min(i, names.size() - 1)];
+  };
+  EXPECT_FLOAT_EQ(material("Offset U").baseColorTexture.offset.x, 0.5f);
+  EXPECT_FLOAT_EQ(material("Offset V").baseColorTexture.offset.y, 0.5f);
+  EXPECT_NEAR(material("Rotation").baseColorTexture.rotation, 0.39269908f, 1e-6f);
+  EXPECT_FLOAT_EQ(material("Scale").baseColorTexture.scale.x, 1.5f);
+  const TextureRef& all = material("All").baseColorTexture;
+  EXPECT_FLOAT_EQ(all.offset.x, -0.2f);
+  EXPECT_FLOAT_EQ(all.offset.y, -0.1f);
+  EXPECT_FLOAT_EQ(all.rotation, 0.3f);
+  EXPECT_FLOAT_EQ(all.scale.y, 1.5f);
+  EXPECT_FLOAT_EQ(material("Correct").baseColorTexture.scale.x, 1.0f);  // no extension: identity
+}
+
+}  // namespace
+}  // namespace pvr

@@ -14,6 +14,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cctype>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <assimp/Importer.hpp>
 #include <filesystem>
 
@@ -120,6 +124,70 @@ Material convertMaterial(const aiScene& as, const aiMaterial& am, const std::str
   return m;
 }
 
+// What assimp 5.2 drops of a glTF file's materials, read from its JSON: KHR_texture_transform on
+// the base colour texture and KHR_materials_emissive_strength. Empty for other formats, or when
+// the JSON cannot be read (assimp then reports the problem itself).
+struct GltfExtras {
+  bool hasTransform = false;
+  TextureRef transform;  ///< offset, scale, rotation, and texCoord if the extension overrides it
+  bool texCoordOverride = false;
+  float emissiveStrength = 1.0f;
+  std::string name;
+};
+
+std::vector<GltfExtras> readGltfExtras(const std::string& path) {
+  using nlohmann::json;
+  std::vector<GltfExtras> out;
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".gltf" && ext != ".glb") return out;
+  std::ifstream in(path, std::ios::binary);
+  std::string text;
+  if (ext == ".glb") {  // header (12 bytes), then the JSON chunk: length, type "JSON", bytes
+    char header[20];
+    if (!in.read(header, 20) || std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0) return out;
+    uint32_t length;
+    std::memcpy(&length, header + 12, 4);
+    if (length > (1u << 28)) return out;
+    text.resize(length);
+    if (!in.read(text.data(), length)) return out;
+  } else {
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  try {
+    json doc = json::parse(text);
+    if (!doc.contains("materials") || !doc["materials"].is_array()) return out;
+    for (const json& m : doc["materials"]) {
+      GltfExtras e;
+      if (!m.is_object()) {
+        out.push_back(e);
+        continue;
+      }
+      if (m.contains("name") && m["name"].is_string()) e.name = m["name"].get<std::string>();
+      const json* strength = nullptr;
+      if (m.contains("extensions") && m["extensions"].contains("KHR_materials_emissive_strength"))
+        strength = &m["extensions"]["KHR_materials_emissive_strength"];
+      if (strength && strength->contains("emissiveStrength") && (*strength)["emissiveStrength"].is_number())
+        e.emissiveStrength = (*strength)["emissiveStrength"].get<float>();
+      if (m.contains("pbrMetallicRoughness") && m["pbrMetallicRoughness"].contains("baseColorTexture")) {
+        const json& t = m["pbrMetallicRoughness"]["baseColorTexture"];
+        if (t.contains("extensions") && t["extensions"].contains("KHR_texture_transform")) {
+          const json& x = t["extensions"]["KHR_texture_transform"];
+          e.hasTransform = true;
+          if (x.contains("offset") && x["offset"].size() == 2) e.transform.offset = {x["offset"][0].get<float>(), x["offset"][1].get<float>()};
+          if (x.contains("scale") && x["scale"].size() == 2) e.transform.scale = {x["scale"][0].get<float>(), x["scale"][1].get<float>()};
+          if (x.contains("rotation")) e.transform.rotation = x["rotation"].get<float>();
+          if (x.contains("texCoord")) e.transform.texCoord = x["texCoord"].get<uint32_t>(), e.texCoordOverride = true;
+        }
+      }
+      out.push_back(e);
+    }
+  } catch (const std::exception&) {
+    out.clear();
+  }
+  return out;
+}
+
 }  // namespace
 
 void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& options) {
@@ -145,10 +213,31 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
     throw Error("cannot read '" + path + "': the file is incomplete");
   std::vector<uint32_t> materialMap(as->mNumMaterials);
   TextureLoader textures(scene);
+  const std::vector<GltfExtras> gltfExtras = readGltfExtras(path);
   const std::string folder = fs::path(path).parent_path().string();
   for (unsigned i = 0; i < as->mNumMaterials; ++i)
   {
     Material m = convertMaterial(*as, *as->mMaterials[i], folder, textures);
+    // assimp reorders the file's materials: find this one by its (unique) name, or by index when
+    // the file names none.
+    const GltfExtras* found = nullptr;
+    const std::string materialName = as->mMaterials[i]->GetName().C_Str();
+    int sameName = 0;
+    for (const GltfExtras& e : gltfExtras)
+      if (!materialName.empty() && e.name == materialName) found = &e, ++sameName;
+    if (sameName > 1) found = nullptr;
+    bool anyNamed = std::any_of(gltfExtras.begin(), gltfExtras.end(), [](const GltfExtras& e) { return !e.name.empty(); });
+    if (!found && !anyNamed && i < gltfExtras.size()) found = &gltfExtras[i];
+    if (found) {
+      const GltfExtras& e = *found;
+      if (e.hasTransform && m.baseColorTexture.present()) {
+        m.baseColorTexture.offset = e.transform.offset;
+        m.baseColorTexture.scale = e.transform.scale;
+        m.baseColorTexture.rotation = e.transform.rotation;
+        if (e.texCoordOverride) m.baseColorTexture.texCoord = e.transform.texCoord > 1 ? 0u : e.transform.texCoord;
+      }
+      if (std::isfinite(e.emissiveStrength) && e.emissiveStrength >= 0.0f) m.emission *= e.emissiveStrength;
+    }
     m.emission *= options.emissionScale;
     materialMap[i] = scene.addMaterial(m, as->mMaterials[i]->GetName().C_Str());
   }
