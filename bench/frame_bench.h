@@ -7,7 +7,9 @@
 //  - grid: the hash-grid build of 1M photons on the GPU;
 //  - stereo: the paper's empty Table 5, separate rendering against binocular reuse (scatter, the
 //    paper's; gather, ours), with the right eye's reuse fraction, cost and image quality;
-//  - foveation: foveated against full-resolution frames, and the temporal flicker with and without TAA.
+//  - foveation: foveated against full-resolution frames, and the temporal flicker with and without TAA;
+//  - scenes: textured scenes (Dabrovic Sponza, Sibenik) with full shading: separate and gather
+//    frames, the cost of texture sampling, and each image's error against 16x the photons.
 // Every suite checks its own results and says which GPU, resolution, photons and radius it ran.
 // Timings are tail latencies (one slow frame drops a frame in the headset): every frame cell keeps
 // each timed frame's wall time and stage times and reports their mean, p50, p99 and max
@@ -25,6 +27,8 @@ struct FrameBenchArgs {
   std::string stereo = "separate,scatter,gather";  ///< Table 5's columns
   std::string stereoScenes = "cornell,cornell-caustics";  ///< Table 5 on the first; the others: one row
   std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
+  std::string scenes = "scenes/dabrovic-sponza.json,scenes/sibenik.json";  ///< scenes suite; absent meshes: skipped
+  float sceneRadius = 0.15f;  ///< scenes suite: the search radius, scene units
   int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)
   int warmup = 10;
   int k = 32;

@@ -515,7 +515,8 @@ int runCli(int argc, char** argv) {
                "CUDA ray throughput (rays), GPU hash-grid build (grid), CPU photon-map queries (maps)");
   bench->add_option("scene", ba.scene, "Scene for the tables, grid and maps suites")->capture_default_str();
   bench->add_option("--suite", fa.suite,
-                    "tables | rays | grid | stereo | all (tables, stereo, rays, grid) | maps (CPU map queries)")
+                    "tables | rays | grid | stereo | foveation | scenes (textured scenes, full shading) | all (tables, "
+                    "stereo, rays, grid) | maps (CPU map queries)")
       ->capture_default_str();
   bench->add_option("--stereo", fa.stereo, "Table 5's columns: separate, scatter, gather (stereo suite)")
       ->capture_default_str();
@@ -530,6 +531,8 @@ int runCli(int argc, char** argv) {
   bench->add_option("--warmup", fa.warmup, "Warm-up frames per cell (tables suite)")->capture_default_str();
   bench->add_option("--eye-size", fa.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
   bench->add_option("--rays-scenes", fa.raysScene, "Scenes of the rays suite")->capture_default_str();
+  bench->add_option("--scenes", fa.scenes, "Scenes of the scenes suite (absent meshes are skipped)")->capture_default_str();
+  bench->add_option("--scene-radius", fa.sceneRadius, "Search radius of the scenes suite, scene units")->capture_default_str();
   bench->add_option("--photons", ba.photons, "Comma-separated photon grids (maps suite)")->capture_default_str();
   bench->add_option("--radii", ba.radii, "Comma-separated search radii (maps suite)")->capture_default_str();
   bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye (maps suite)")

@@ -160,6 +160,40 @@ uint32_t Scene::addPunctualLight(const PunctualLight& light, const std::string& 
   return uint32_t(punctualLights_.size() - 1);
 }
 
+Scene::Scene(const Scene& other) { *this = other; }
+
+Scene& Scene::operator=(const Scene& other) {
+  if (this == &other) return *this;
+  vertices_ = other.vertices_;
+  normals_ = other.normals_;
+  faceNormals_ = other.faceNormals_;
+  uvs_[0] = other.uvs_[0];
+  uvs_[1] = other.uvs_[1];
+  indices_ = other.indices_;
+  materialIds_ = other.materialIds_;
+  textureTexels_ = other.textureTexels_;
+  textures_ = other.textures_;
+  for (size_t i = 0; i < textures_.size(); ++i) textures_[i].texels = textureTexels_[i].data();
+  materials_ = other.materials_;
+  materialNames_ = other.materialNames_;
+  meshes_ = other.meshes_;
+  lightTriangles_ = other.lightTriangles_;
+  punctualLights_ = other.punctualLights_;
+  lightCdf_ = other.lightCdf_;
+  skippedTriangles_ = other.skippedTriangles_;
+  sceneRadius_ = other.sceneRadius_;
+  sceneCenter_ = other.sceneCenter_;
+  rig = other.rig;
+  name = other.name;
+  return *this;
+}
+
+Scene Scene::withoutColourTextures() const {
+  Scene copy(*this);
+  for (Material& m : copy.materials_) m.baseColorTexture = TextureRef();
+  return copy;
+}
+
 bool Scene::hasAlphaTestedMaterial() const {
   return std::any_of(materials_.begin(), materials_.end(), [](const Material& m) { return m.alphaTested(); });
 }

@@ -18,6 +18,15 @@ struct MeshRange {
 
 class Scene {
  public:
+  Scene() = default;
+  Scene(const Scene& other);  // textures' views point into the copy's own texels
+  Scene& operator=(const Scene& other);
+  Scene(Scene&&) noexcept = default;
+  Scene& operator=(Scene&&) noexcept = default;
+  // The same scene with every base-colour texture dropped (the constant colours stay; cut-outs
+  // keep their masks): what textures cost, measured against it.
+  Scene withoutColourTextures() const;
+
   uint32_t addMaterial(const Material& m, const std::string& name);
   // Adds a mesh; triangles with a non-finite vertex or (near) zero area are skipped and counted
   // in skippedTriangles(). `normals` is empty or one per vertex.
