@@ -341,6 +341,15 @@ Scene texturedLitCornell() {
   Material m;
   m.baseColorTexture.texture = int32_t(scene.addTexture("checker", 64, 64, texels, true));
   m.alphaMode = AlphaMode::Mask;
+  std::vector<uint32_t> normals;  // a wavy normal map: the panel's shading normals bend across it
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      float a = 0.4f * std::sin(0.8f * x), b = 0.3f * std::cos(0.6f * y);
+      Vec3 n = normalize(Vec3(a, b, 1.0f));
+      auto code = [](float c) { return uint32_t(std::lround(255.0f * (0.5f * c + 0.5f))); };
+      normals.push_back(code(n.x) | code(n.y) << 8 | code(n.z) << 16 | 0xff000000u);
+    }
+  m.normalTexture.texture = int32_t(scene.addTexture("waves", 16, 16, normals, false));
   uint32_t id = scene.addMaterial(m, "checker");
   std::vector<Vec2> uvs[2] = {{{0, 0}, {3, 0}, {3, 3}, {0, 3}}, {}};
   scene.addMesh("panel", {{-0.35f, 0.15f, -0.45f}, {0.35f, 0.15f, -0.45f}, {0.35f, 0.85f, -0.3f}, {-0.35f, 0.85f, -0.3f}}, {},
@@ -365,7 +374,7 @@ Scene texturedLitCornell() {
   return scene;
 }
 
-TEST(GpuBackend, TexturesAlphaAndPunctualLightsMatchTheCpu) {
+TEST(GpuBackend, TexturesNormalMapsAlphaAndPunctualLightsMatchTheCpu) {
   PVR_REQUIRE_GPU();
   Scene scene = texturedLitCornell();
   StereoRig rig = scene.rig;

@@ -361,3 +361,88 @@ TEST(SceneImport, GltfTextureTransformIsRead) {
 
 }  // namespace
 }  // namespace pvr
+
+namespace pvr {
+namespace {
+
+// A constant normal map tilting the normal by 30 degrees towards +u: under a light straight above
+// the plane the cosine becomes that of the decoded normal's tilt; a flat map (0.5, 0.5, 1)
+// changes nothing; and a bump map's slopes lean the normal away from the rise.
+TEST(NormalMaps, ConstantTiltScalesTheCosineAsExpected) {
+  auto floorWith = [](uint32_t texel, Vec3* decoded) {
+    Scene scene;
+    Material m;
+    m.albedo = {1, 1, 1};
+    m.normalTexture.texture = int32_t(scene.addTexture("n", 2, 2, std::vector<uint32_t>(4, texel), false));
+    uint32_t id = scene.addMaterial(m, "floor");
+    // Floor y = 0 facing +Y; u along +x, v along +z (so "up the image", -v, is -z).
+    std::vector<Vec2> uvs[2] = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {}};
+    scene.addMesh("floor", {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}}, {}, uvs, {0, 2, 1, 0, 3, 2}, id);
+    PunctualLight lamp;
+    lamp.position = {0, 2, 0};
+    lamp.intensity = {10, 10, 10};
+    scene.addPunctualLight(lamp, "lamp");
+    scene.finalize();
+    if (decoded) {
+      Rgba c = decodeTexel(texel, false);
+      *decoded = normalize(Vec3(2 * c.rgb.x - 1, 2 * c.rgb.y - 1, 2 * c.rgb.z - 1));
+    }
+    return scene;
+  };
+  auto code = [](float c) { return uint32_t(std::lround(255.0f * (0.5f * c + 0.5f))); };
+  const float tilt = 30.0f * kPi / 180.0f;
+  const uint32_t tilted = code(std::sin(tilt)) | code(0.0f) << 8 | code(std::cos(tilt)) << 16 | 255u << 24;
+  const uint32_t flat = code(0.0f) | code(0.0f) << 8 | code(1.0f) << 16 | 255u << 24;
+  Vec3 n;
+  Scene scene = floorWith(tilted, &n);
+  SceneView v = scene.view();
+  Hit hit;
+  hit.primId = 0, hit.u = 0.3f, hit.v = 0.3f, hit.t = 1.0f;
+  SurfacePoint sp = v.surfacePoint(hit);
+  // Tangent space (x along +u = +x, y up the image = -z, z = +Y): world (n.x, n.z, -n.y).
+  EXPECT_NEAR(sp.shadingNormal.x, n.x, 1e-5f);
+  EXPECT_NEAR(sp.shadingNormal.y, n.z, 1e-5f);
+  EXPECT_NEAR(sp.shadingNormal.z, -n.y, 1e-5f);
+  EmbreeIntersector intersector(scene);
+  GatherParams params;
+  CounterRng rng(1, 0, 0);
+  Vec3 p = v.surfacePoint(hit).position;
+  Ray down{p + Vec3(0, 1.0f, 0.2f), normalize(Vec3(0, -1.0f, -0.2f))};
+  float r2 = lengthSquared(Vec3(0, 2, 0) - p);
+  Vec3 wi = normalize(Vec3(0, 2, 0) - p);
+  float L = traceToDiffuse(v, intersector, params, down, rng).radiance.x;
+  EXPECT_NEAR(L, 10.0f * dot(sp.shadingNormal, wi) / r2 / kPi, 1e-4f * L);
+  EXPECT_LT(dot(sp.shadingNormal, Vec3(0, 1, 0)), 0.9f);  // really tilted
+
+  Scene plain = floorWith(flat, nullptr);
+  EXPECT_NEAR(plain.view().surfacePoint(hit).shadingNormal.y, 1.0f, 1e-3f);
+}
+
+}  // namespace
+}  // namespace pvr
+
+#include "pvr/scene/texture_file.h"
+
+namespace pvr {
+namespace {
+
+TEST(NormalMaps, BumpSlopesLeanTheNormalAwayFromTheRise) {
+  Scene scene;
+  std::vector<uint32_t> ramp;  // height rises along +x (+u), flat along y
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) ramp.push_back(uint32_t(20 * x) * 0x010101u | 0xff000000u);
+  int32_t height = int32_t(scene.addTexture("ramp", 8, 8, ramp, false, WrapMode::ClampToEdge, WrapMode::ClampToEdge));
+  TextureLoader loader(scene);
+  int32_t normals = loader.normalsFromHeight(height, 4.0f);
+  ASSERT_GE(normals, 0);
+  Rgba c = sampleTexture(scene.textureViews()[size_t(normals)], {0.5f, 0.5f}, 0.0f);
+  Vec3 n{2 * c.rgb.x - 1, 2 * c.rgb.y - 1, 2 * c.rgb.z - 1};
+  float slope = 4.0f * 20.0f / 255.0f;  // strength x height step per texel
+  EXPECT_NEAR(n.x, -slope / std::sqrt(1 + slope * slope), 0.01f);
+  EXPECT_NEAR(n.y, 0.0f, 0.01f);
+  EXPECT_GT(n.z, 0.0f);
+  EXPECT_EQ(loader.normalsFromHeight(-1, 1.0f), -1);
+}
+
+}  // namespace
+}  // namespace pvr

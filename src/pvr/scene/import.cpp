@@ -91,6 +91,17 @@ Material convertMaterial(const aiScene& as, const aiMaterial& am, const std::str
   m.baseColorTexture = textureOf(as, am, aiTextureType_BASE_COLOR, true, folder, textures);
   if (!m.baseColorTexture.present()) m.baseColorTexture = textureOf(as, am, aiTextureType_DIFFUSE, true, folder, textures);
   m.opacityTexture = textureOf(as, am, aiTextureType_OPACITY, false, folder, textures);
+  m.normalTexture = textureOf(as, am, aiTextureType_NORMALS, false, folder, textures);
+  if (m.normalTexture.present()) {
+    float scale = 1.0f;
+    if (am.Get(AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_NORMALS, 0), scale) == AI_SUCCESS && std::isfinite(scale)) m.normalScale = scale;
+  } else {  // a bump (height) map (OBJ map_bump, 3DS bump): its slopes become a normal map
+    TextureRef bump = textureOf(as, am, aiTextureType_HEIGHT, false, folder, textures);
+    if (bump.present()) {
+      bump.texture = textures.normalsFromHeight(bump.texture, 4.0f);
+      m.normalTexture = bump;
+    }
+  }
   aiString alphaMode;
   const bool gltf = am.Get(AI_MATKEY_GLTF_ALPHAMODE, alphaMode) == AI_SUCCESS;
   if (gltf) {

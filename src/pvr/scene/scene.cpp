@@ -70,7 +70,7 @@ void Scene::finalize() {
     faceNormals_[t] = normalize(cross(b - a, c - a));
   }
   for (size_t i = 0; i < materials_.size(); ++i)
-    for (const TextureRef* ref : {&materials_[i].baseColorTexture, &materials_[i].opacityTexture})
+    for (const TextureRef* ref : {&materials_[i].baseColorTexture, &materials_[i].opacityTexture, &materials_[i].normalTexture})
       if (ref->texture >= int32_t(textures_.size()))
         throw Error("material '" + materialNames_[i] + "' refers to a missing texture");
   lightTriangles_.clear();

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -79,6 +80,30 @@ int32_t TextureLoader::fromMemory(const std::string& key, const unsigned char* b
   }
   int32_t index = decoded(key, rgba, w, h, srgb, s, t);
   stbi_image_free(rgba);
+  return index;
+}
+
+int32_t TextureLoader::normalsFromHeight(int32_t height, float strength) {
+  if (height < 0) return -1;
+  const std::string key = "normals of texture " + std::to_string(height) + " x" + std::to_string(strength);
+  auto cached = cache_.find(key);
+  if (cached != cache_.end()) return cached->second;
+  const TextureView& view = scene_.textureViews()[size_t(height)];
+  const std::vector<uint32_t> texels = scene_.textureTexels(uint32_t(height));
+  const int w = view.width, h = view.height;
+  const WrapMode s = view.wrapS, t = view.wrapT;
+  auto at = [&](int x, int y) { return float(texels[size_t(wrapTexel(y, h, t)) * w + wrapTexel(x, w, s)] & 255u) / 255.0f; };
+  std::vector<uint32_t> normals(size_t(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      // Central differences; the surface rises where the height grows, so the normal leans away.
+      float dx = 0.5f * (at(x + 1, y) - at(x - 1, y)) * strength, dUp = 0.5f * (at(x, y - 1) - at(x, y + 1)) * strength;
+      Vec3 n = normalize(Vec3(-dx, -dUp, 1.0f));
+      auto code = [](float c) { return uint32_t(std::lround(255.0f * std::clamp(0.5f * c + 0.5f, 0.0f, 1.0f))); };
+      normals[size_t(y) * w + x] = code(n.x) | code(n.y) << 8 | code(n.z) << 16 | 255u << 24;
+    }
+  int32_t index = int32_t(scene_.addTexture(key, w, h, std::move(normals), false, s, t));
+  cache_[key] = index;
   return index;
 }
 

@@ -19,6 +19,9 @@ class TextureLoader {
   int32_t fromMemory(const std::string& key, const unsigned char* bytes, size_t size, bool srgb, WrapMode s, WrapMode t);
   // Uncompressed texels (assimp's embedded aiTexel: B, G, R, A bytes per texel).
   int32_t fromBgra(const std::string& key, const unsigned char* bgra, int width, int height, bool srgb, WrapMode s, WrapMode t);
+  // A tangent-space normal map made from a height (bump) map: the slopes of its first channel,
+  // `strength` height units per texel at full range. -1 if `height` is -1.
+  int32_t normalsFromHeight(int32_t height, float strength);
   size_t warnings() const { return warnings_; }
 
  private:

@@ -20,6 +20,8 @@ struct Material {
   float ior = 1.5f;               ///< index of refraction (glass only)
   TextureRef baseColorTexture;    ///< multiplies albedo (RGB) and alpha (A)
   TextureRef opacityTexture;      ///< OBJ's map_d: alpha from its first channel
+  TextureRef normalTexture;       ///< tangent-space normal map (glTF's convention: +X along +u, +Y up the image)
+  float normalScale = 1.0f;       ///< glTF's normalTexture.scale: multiplies the map's X and Y
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alpha = 1.0f;             ///< baseColorFactor's alpha
   float alphaCutoff = 0.5f;       ///< MASK: texels with alpha below this are cut out

@@ -91,7 +91,40 @@ struct SceneView {
       }
     }
     sp.materialId = materialIds[hit.primId];
+    const Material& m = materials[sp.materialId];
+    if (m.normalTexture.present()) sp.shadingNormal = normalMapped(m, hit.primId, hit.u, hit.v, sp.shadingNormal, sp.geometricNormal);
     return sp;
+  }
+
+  // The shading normal bent by a tangent-space normal map. The tangent frame is the triangle's:
+  // T along +u, the second axis up the image (towards -v, as glTF's +Y), both orthogonalised
+  // against the interpolated normal. A bent normal that would face away from the surface, or a
+  // triangle without a usable UV mapping, keeps the unbent one.
+  PVR_HOST_DEVICE Vec3 normalMapped(const Material& m, uint32_t prim, float u, float v, Vec3 n, Vec3 geometric) const {
+    const Vec2* t = uvs[m.normalTexture.texCoord & 1u];
+    if (!t) return n;
+    Vec3 a, b, c;
+    triangle(prim, a, b, c);
+    Vec2 ta = t[indices[3 * prim]], tb = t[indices[3 * prim + 1]], tc = t[indices[3 * prim + 2]];
+    float du1 = tb.x - ta.x, dv1 = tb.y - ta.y, du2 = tc.x - ta.x, dv2 = tc.y - ta.y;
+    float det = du1 * dv2 - du2 * dv1;
+    if (!(fabsf(det) > 1e-20f)) return n;
+    Vec3 e1 = b - a, e2 = c - a;
+    Vec3 dpdu = (e1 * dv2 - e2 * dv1) * (1.0f / det), dpdv = (e2 * du1 - e1 * du2) * (1.0f / det);
+    Vec3 tangent = dpdu - n * dot(n, dpdu);
+    float tl = length(tangent);
+    if (!(tl > 0.0f)) return n;
+    tangent = tangent * (1.0f / tl);
+    Vec3 up = cross(n, tangent);
+    if (dot(up, dpdv) > 0.0f) up = -up;  // towards -v: up the image
+    Rgba texel = sampleRef(m.normalTexture, prim, u, v, 0.0f);
+    float x = (2.0f * texel.rgb.x - 1.0f) * m.normalScale, y = (2.0f * texel.rgb.y - 1.0f) * m.normalScale;
+    float z = 2.0f * texel.rgb.z - 1.0f;
+    Vec3 bent = tangent * x + up * y + n * z;
+    float len = length(bent);
+    if (!(len > 0.0f)) return n;
+    bent = bent * (1.0f / len);
+    return dot(bent, geometric) * dot(n, geometric) > 0.0f ? bent : n;
   }
 
   PVR_HOST_DEVICE float triangleArea(uint32_t prim) const {
