@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <vector>
 
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
@@ -287,6 +288,46 @@ void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2],
     vkCmdResetQueryPool(cmd, timestamps_, query, 2);
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, query);
   }
+  // Memory CUDA wrote is acquired from the external queue family before the copies read it, and
+  // released back after them (the external-memory ownership rules).
+  std::vector<VkBufferMemoryBarrier> acquire, release;
+  std::vector<VkImageMemoryBarrier> acquireImages, releaseImages;
+  if (anyCuda) {
+    for (int e = 0; e < 2; ++e) {
+      if (!source[e].deviceImage || !target[e].colour) continue;
+      auto buffer = [&](VkBuffer b, bool toUs) {
+        VkBufferMemoryBarrier x{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+        x.srcAccessMask = toUs ? 0 : VK_ACCESS_TRANSFER_READ_BIT;
+        x.dstAccessMask = toUs ? VK_ACCESS_TRANSFER_READ_BIT : 0;
+        x.srcQueueFamilyIndex = toUs ? VK_QUEUE_FAMILY_EXTERNAL : vk_.queueFamily();
+        x.dstQueueFamilyIndex = toUs ? vk_.queueFamily() : VK_QUEUE_FAMILY_EXTERNAL;
+        x.buffer = b;
+        x.size = VK_WHOLE_SIZE;
+        return x;
+      };
+      if (slot.colour[e].buffer) acquire.push_back(buffer(slot.colour[e].buffer, true)), release.push_back(buffer(slot.colour[e].buffer, false));
+      if (options_.depth && slot.depth[e].buffer)
+        acquire.push_back(buffer(slot.depth[e].buffer, true)), release.push_back(buffer(slot.depth[e].buffer, false));
+      if (slot.colourImage[e].image) {
+        auto image = [&](bool toUs) {
+          VkImageMemoryBarrier x{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+          x.srcAccessMask = toUs ? 0 : VK_ACCESS_TRANSFER_READ_BIT;
+          x.dstAccessMask = toUs ? VK_ACCESS_TRANSFER_READ_BIT : 0;
+          x.oldLayout = x.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+          x.srcQueueFamilyIndex = toUs ? VK_QUEUE_FAMILY_EXTERNAL : vk_.queueFamily();
+          x.dstQueueFamilyIndex = toUs ? vk_.queueFamily() : VK_QUEUE_FAMILY_EXTERNAL;
+          x.image = slot.colourImage[e].image;
+          x.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+          return x;
+        };
+        acquireImages.push_back(image(true));
+        releaseImages.push_back(image(false));
+      }
+    }
+    if (!acquire.empty() || !acquireImages.empty())
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                           uint32_t(acquire.size()), acquire.data(), uint32_t(acquireImages.size()), acquireImages.data());
+  }
   for (int e = 0; e < 2; ++e) {
     if (!source[e].present() || !target[e].colour) continue;
     VkBufferImageCopy region{};
@@ -311,6 +352,9 @@ void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2],
       transitionImage(cmd, target[e].depth, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, target[e].depthLayout);
     }
   }
+  if (!release.empty() || !releaseImages.empty())
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0, 0, nullptr,
+                         uint32_t(release.size()), release.data(), uint32_t(releaseImages.size()), releaseImages.data());
   if (timestamps_) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, query + 1);
   vkCheck(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
   vkCheck(vkResetFences(vk_.device(), 1, &slot.fence), "vkResetFences");
