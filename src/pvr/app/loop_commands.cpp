@@ -16,6 +16,7 @@
 #include "pvr/util/error.h"
 #include "pvr/viewer/viewer_presenter.h"
 #include "pvr/vk/eye_transfer.h"
+#include "pvr/vk/frame_source.h"
 #include "pvr/xr/xr_presenter.h"
 #ifdef PVR_HAVE_CUDA
 #include "pvr/cuda/display_handover.h"
@@ -129,14 +130,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
         EyeSource sources[2];
         EyeTarget targets[2];
         for (int e = 0; e < 2; ++e) {
-          if (f.onDevice) {
-            sources[e].deviceImage = f.renderer.deviceImage(Eye(e));
-            sources[e].deviceInverseDepth = f.renderer.deviceInverseDepth(Eye(e));
-            sources[e].deviceStream = f.renderer.deviceStream();
-          } else {
-            sources[e].image = &f.result->eyes[e].image;
-            sources[e].inverseDepth = &f.result->eyes[e].inverseDepth;
-          }
+          sources[e] = eyeSourceOf(f, Eye(e));
           targets[e] = {colour[e].image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, depth[e].image,
                         VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
         }

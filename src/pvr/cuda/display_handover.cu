@@ -36,9 +36,9 @@ __global__ void encodeEyeSurfaceKernel(const Vec3* image, const float* inverseDe
   if (depth) depth[i] = inverseDepth ? reversedDepth(inverseDepth[i], nearZ) : 0.0f;
 }
 
-}  // namespace
-
-SharedSurface::SharedSurface(int fd, size_t allocationBytes, int width, int height, int bytesPerPixel) {
+// A dedicated Vulkan allocation (an opaque fd) imported into CUDA, which takes the fd over; on
+// failure the fd is closed here and `what` names the step.
+cudaExternalMemory_t importVulkanMemory(int fd, size_t allocationBytes, const char* what) {
   cudaExternalMemoryHandleDesc desc{};
   desc.type = cudaExternalMemoryHandleTypeOpaqueFd;
   desc.handle.fd = fd;
@@ -47,9 +47,16 @@ SharedSurface::SharedSurface(int fd, size_t allocationBytes, int width, int heig
   cudaExternalMemory_t memory;
   cudaError_t status = cudaImportExternalMemory(&memory, &desc);
   if (status != cudaSuccess) {
-    close(fd);
-    throwCudaError(status, "importing a Vulkan image (cudaImportExternalMemory)", __FILE__, __LINE__);
+    close(fd);  // not taken over on failure
+    throwCudaError(status, what, __FILE__, __LINE__);
   }
+  return memory;
+}
+
+}  // namespace
+
+SharedSurface::SharedSurface(int fd, size_t allocationBytes, int width, int height, int bytesPerPixel) {
+  cudaExternalMemory_t memory = importVulkanMemory(fd, allocationBytes, "importing a Vulkan image (cudaImportExternalMemory)");
   memory_ = memory;
   cudaExternalMemoryMipmappedArrayDesc arrayDesc{};
   arrayDesc.offset = 0;
@@ -59,7 +66,7 @@ SharedSurface::SharedSurface(int fd, size_t allocationBytes, int width, int heig
   arrayDesc.flags = cudaArraySurfaceLoadStore;
   arrayDesc.numLevels = 1;
   cudaMipmappedArray_t mipmapped;
-  status = cudaExternalMemoryGetMappedMipmappedArray(&mipmapped, memory, &arrayDesc);
+  cudaError_t status = cudaExternalMemoryGetMappedMipmappedArray(&mipmapped, memory, &arrayDesc);
   if (status != cudaSuccess) {
     cudaDestroyExternalMemory(memory);
     memory_ = nullptr;
@@ -102,22 +109,12 @@ bool currentDeviceUuid(uint8_t uuid[16]) {
 }
 
 SharedBuffer::SharedBuffer(int fd, size_t allocationBytes, size_t usedBytes) {
-  cudaExternalMemoryHandleDesc desc{};
-  desc.type = cudaExternalMemoryHandleTypeOpaqueFd;
-  desc.handle.fd = fd;
-  desc.size = allocationBytes;
-  desc.flags = cudaExternalMemoryDedicated;
-  cudaExternalMemory_t memory;
-  cudaError_t status = cudaImportExternalMemory(&memory, &desc);
-  if (status != cudaSuccess) {
-    close(fd);  // not taken over on failure
-    throwCudaError(status, "importing a Vulkan buffer (cudaImportExternalMemory)", __FILE__, __LINE__);
-  }
+  cudaExternalMemory_t memory = importVulkanMemory(fd, allocationBytes, "importing a Vulkan buffer (cudaImportExternalMemory)");
   memory_ = memory;
   cudaExternalMemoryBufferDesc buffer{};
   buffer.offset = 0;
   buffer.size = usedBytes;
-  status = cudaExternalMemoryGetMappedBuffer(&data_, memory, &buffer);
+  cudaError_t status = cudaExternalMemoryGetMappedBuffer(&data_, memory, &buffer);
   if (status != cudaSuccess) {
     cudaDestroyExternalMemory(memory);
     throwCudaError(status, "mapping a Vulkan buffer (cudaExternalMemoryGetMappedBuffer)", __FILE__, __LINE__);

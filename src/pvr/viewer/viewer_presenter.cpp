@@ -18,6 +18,7 @@
 #include "pvr/image/image_io.h"
 #include "pvr/util/error.h"
 #include "pvr/vk/eye_transfer.h"
+#include "pvr/vk/frame_source.h"
 #include "pvr/vk/vulkan_context.h"
 #ifdef PVR_HAVE_CUDA
 #include "pvr/cuda/display_handover.h"
@@ -534,12 +535,7 @@ void ViewerPresenter::present(const PresentedFrame& frame) {
     EyeTarget targets[2];
     for (int e = 0; e < 2; ++e) {
       if (e == 1 && !frame.renderer.options().eyes[1]) continue;
-      if (frame.onDevice) {
-        sources[e].deviceImage = frame.renderer.deviceImage(Eye(e));
-        sources[e].deviceStream = frame.renderer.deviceStream();
-      } else {
-        sources[e].image = &frame.result->eyes[e].image;
-      }
+      sources[e] = eyeSourceOf(frame, Eye(e));
       targets[e] = {m.eyes[e].image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
     }
     m.transfer->handOver(sources, targets);

@@ -234,6 +234,28 @@ VulkanBuffer::~VulkanBuffer() {
 
 namespace {
 
+// Memory for one buffer or image. Exportable memory is a dedicated allocation exported as an
+// opaque fd (CUDA imports it as dedicated).
+VkDeviceMemory allocate(const VulkanContext& vk, const VkMemoryRequirements& req, VkMemoryPropertyFlags properties,
+                        bool exportable, VkBuffer buffer, VkImage image, const char* what) {
+  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
+  dedicated.buffer = buffer;
+  dedicated.image = image;
+  VkExportMemoryAllocateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO};
+  exportInfo.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  exportInfo.pNext = &dedicated;
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.pNext = exportable ? &exportInfo : nullptr;
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = vk.memoryType(req.memoryTypeBits, properties);
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkResult r = vkAllocateMemory(vk.device(), &mai, nullptr, &memory);
+  if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
+    throw Error("Vulkan: out of memory for a " + std::to_string(req.size >> 20) + " MiB " + what);
+  vkCheck(r, "vkAllocateMemory");
+  return memory;
+}
+
 VulkanBuffer makeBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage, bool exportable) {
   VulkanBuffer b;
   b.device = vk.device();
@@ -248,20 +270,9 @@ VulkanBuffer makeBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsag
   vkCheck(vkCreateBuffer(b.device, &bci, nullptr, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(b.device, b.buffer, &req);
-  VkExportMemoryAllocateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO};
-  exportInfo.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
-  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
-  dedicated.buffer = b.buffer;
-  exportInfo.pNext = &dedicated;  // one allocation per shared buffer: CUDA imports it as dedicated
-  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  mai.pNext = exportable ? &exportInfo : nullptr;
-  mai.allocationSize = req.size;
-  mai.memoryTypeIndex = vk.memoryType(req.memoryTypeBits, exportable ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
-                                                                    : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-  VkResult r = vkAllocateMemory(b.device, &mai, nullptr, &b.memory);
-  if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
-    throw Error("Vulkan: out of memory for a " + std::to_string(size >> 20) + " MiB eye buffer");
-  vkCheck(r, "vkAllocateMemory");
+  b.memory = allocate(vk, req, exportable ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
+                                          : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                      exportable, b.buffer, VK_NULL_HANDLE, "eye buffer");
   b.allocationSize = req.size;
   vkCheck(vkBindBufferMemory(b.device, b.buffer, b.memory, 0), "vkBindBufferMemory");
   if (!exportable) vkCheck(vkMapMemory(b.device, b.memory, 0, size, 0, &b.mapped), "vkMapMemory");
@@ -319,17 +330,8 @@ VulkanImage createImage(const VulkanContext& vk, int width, int height, VkFormat
   vkCheck(vkCreateImage(img.device, &ici, nullptr, &img.image), "vkCreateImage");
   VkMemoryRequirements req;
   vkGetImageMemoryRequirements(img.device, img.image, &req);
-  VkMemoryDedicatedAllocateInfo dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
-  dedicated.image = img.image;
-  VkExportMemoryAllocateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO};
-  exportInfo.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
-  exportInfo.pNext = &dedicated;
-  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  if (exportable) mai.pNext = &exportInfo;
-  mai.allocationSize = req.size;
+  img.memory = allocate(vk, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, exportable, VK_NULL_HANDLE, img.image, "eye image");
   img.allocationSize = req.size;
-  mai.memoryTypeIndex = vk.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  vkCheck(vkAllocateMemory(img.device, &mai, nullptr, &img.memory), "vkAllocateMemory (image)");
   vkCheck(vkBindImageMemory(img.device, img.image, img.memory, 0), "vkBindImageMemory");
   return img;
 }

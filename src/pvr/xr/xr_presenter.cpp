@@ -17,6 +17,7 @@
 
 #include "pvr/util/error.h"
 #include "pvr/vk/eye_transfer.h"
+#include "pvr/vk/frame_source.h"
 #include "pvr/vk/vulkan_context.h"
 #include "pvr/xr/xr_views.h"
 #ifdef PVR_HAVE_CUDA
@@ -523,14 +524,7 @@ void XrPresenter::present(const PresentedFrame& frame) {
     EyeSource sources[2];
     EyeTarget targets[2];
     for (int e = 0; e < 2; ++e) {
-      if (frame.onDevice) {
-        sources[e].deviceImage = frame.renderer.deviceImage(Eye(e));
-        sources[e].deviceInverseDepth = frame.renderer.deviceInverseDepth(Eye(e));
-        sources[e].deviceStream = frame.renderer.deviceStream();
-      } else {
-        sources[e].image = &frame.result->eyes[e].image;
-        sources[e].inverseDepth = &frame.result->eyes[e].inverseDepth;
-      }
+      sources[e] = eyeSourceOf(frame, Eye(e));
       targets[e].colour = m.acquire(m.colour[e]);
       targets[e].colourLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
       if (m.depthLayer) {
