@@ -178,7 +178,7 @@ struct LitFloor {
     GatherParams params;
     Ray down{p + Vec3(0, 1.0f, 0.3f), normalize(Vec3(0, -1.0f, -0.3f))};
     CounterRng rng(1, 0, 0);
-    return traceToDiffuse(scene.view(), intersector, params, down, rng).radiance;
+    return traceToGatherPoint(scene.view(), intersector, params, down, rng).radiance;
   }
 };
 
@@ -410,7 +410,7 @@ TEST(NormalMaps, ConstantTiltScalesTheCosineAsExpected) {
   Ray down{p + Vec3(0, 1.0f, 0.2f), normalize(Vec3(0, -1.0f, -0.2f))};
   float r2 = lengthSquared(Vec3(0, 2, 0) - p);
   Vec3 wi = normalize(Vec3(0, 2, 0) - p);
-  float L = traceToDiffuse(v, intersector, params, down, rng).radiance.x;
+  float L = traceToGatherPoint(v, intersector, params, down, rng).radiance.x;
   EXPECT_NEAR(L, 10.0f * dot(sp.shadingNormal, wi) / r2 / kPi, 1e-4f * L);
   EXPECT_LT(dot(sp.shadingNormal, Vec3(0, 1, 0)), 0.9f);  // really tilted
 

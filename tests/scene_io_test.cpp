@@ -33,7 +33,10 @@ TEST(SceneImport, GltfMaterialsMapToPhotonvrMaterials) {
   EXPECT_EQ(s.triangleCount(), 8u);
   EXPECT_EQ(s.lightTriangleCount(), 2u);
   const Material& floor = materialNamed(s, "floor");
-  EXPECT_EQ(floor.type, MaterialType::Diffuse);
+  EXPECT_EQ(floor.type, MaterialType::Microfacet);  // glTF: a dielectric layer over the diffuse base
+  EXPECT_EQ(floor.metallic, 0.0f);
+  EXPECT_EQ(floor.roughness, 1.0f);
+  EXPECT_NEAR(floor.specularF0, 0.04f, 1e-6f);
   EXPECT_EQ(floor.albedo, Vec3(0.5f, 0.25f, 0.125f));
   EXPECT_EQ(materialNamed(s, "lamp").emission, Vec3(1.0f, 0.5f, 0.25f));
   EXPECT_EQ(materialNamed(s, "chrome").type, MaterialType::Mirror);

@@ -61,7 +61,7 @@ __global__ void __launch_bounds__(kTile* kTile) sharedDensityKernel(HashGridView
           for (uint32_t k = 0; k < n; ++k) {
             float d2 = photonDistance2(gp.position, staged[k].position);
             if (d2 <= searchR2 && photonFacesSurface(staged[k].direction, gp.normal)) {
-              if (E == Estimator::Radius) sum += staged[k].power;
+              if (E == Estimator::Radius) sum += gp.photonContribution(staged[k]);
               else heap.offer(d2, base + k, searchR2);
             }
           }
@@ -70,7 +70,9 @@ __global__ void __launch_bounds__(kTile* kTile) sharedDensityKernel(HashGridView
       }
     }
     if (estimating) {
-      Vec3 flux = E == Estimator::Radius ? sum * (1.0f / (kPi * r2)) : knnFluxDensity(map, heap, r2);
+      Vec3 flux = E == Estimator::Radius
+                      ? sum * (1.0f / (kPi * r2))
+                      : knnFluxDensity(map, heap, r2, [&](const Photon& p) { return gp.photonContribution(p); });
       result = gp.radiance + gp.weight * flux;
     }
   }
@@ -128,7 +130,7 @@ __global__ void warpPerPointDensityKernel(HashGridView map, float radius, const 
       uint32_t end = map.cellStart[first + 3];
       for (uint32_t j = map.cellStart[first] + lane; j < end; j += 32) {
         if (photonDistance2(gp.position, map.position(j)) <= r2 && photonFacesSurface(map.photons[j].direction, gp.normal))
-          sum += map.photons[j].power;
+          sum += gp.photonContribution(map.photons[j]);
       }
     }
     for (int offset = 16; offset > 0; offset >>= 1) {

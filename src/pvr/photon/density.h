@@ -20,28 +20,35 @@ struct DensityParams {
 // A photon counts towards a surface only if it arrived from the side the normal faces.
 PVR_HOST_DEVICE inline bool photonFacesSurface(Vec3 photonDirection, Vec3 n) { return dot(photonDirection, n) < 0.0f; }
 
+// What each photon adds to an estimate: its power, or its power weighted by a view-dependent
+// BSDF for its direction (gather.h's GatherPoint::photonContribution).
+struct PhotonPower {
+  PVR_HOST_DEVICE Vec3 operator()(const Photon& p) const { return p.power; }
+};
+
 // The kNN estimate from a filled heap; with fewer than k photons in reach the estimate's support
 // is the whole maximum radius (r2).
-template <class PhotonMap>
-PVR_HOST_DEVICE Vec3 knnFluxDensity(const PhotonMap& map, const KnnHeap& heap, float r2) {
+template <class PhotonMap, class Weigh = PhotonPower>
+PVR_HOST_DEVICE Vec3 knnFluxDensity(const PhotonMap& map, const KnnHeap& heap, float r2, const Weigh& weigh = Weigh()) {
   if (heap.size == 0) return {0, 0, 0};
   Vec3 sum{0, 0, 0};
-  for (int j = 0; j < heap.size; ++j) sum += map.photons[heap.index[j]].power;
+  for (int j = 0; j < heap.size; ++j) sum += weigh(map.photons[heap.index[j]]);
   float area = kPi * (heap.full() ? heap.maxDist2() : r2);
   return area > 0.0f ? sum * (1.0f / area) : Vec3{0, 0, 0};
 }
 
-// Irradiance-like flux density sum(dPhi) / (pi r^2) at x on a surface with unit normal n facing
-// the viewer; photons that arrived from behind the surface are ignored. Multiply by the diffuse
-// BRDF (albedo / pi) for radiance.
-template <class PhotonMap>
-PVR_HOST_DEVICE Vec3 estimateFluxDensity(const PhotonMap& map, Vec3 x, Vec3 n, const DensityParams& params) {
+// Flux density sum(weigh(photon)) / (pi r^2) at x on a surface with unit normal n facing the
+// viewer; photons that arrived from behind the surface are ignored. With PhotonPower it is the
+// irradiance-like sum(dPhi) / (pi r^2): multiply by the diffuse BRDF (albedo / pi) for radiance.
+template <class PhotonMap, class Weigh = PhotonPower>
+PVR_HOST_DEVICE Vec3 estimateFluxDensity(const PhotonMap& map, Vec3 x, Vec3 n, const DensityParams& params,
+                                         const Weigh& weigh = Weigh()) {
   float r2 = params.radius * params.radius;
   if (params.estimator == Estimator::Radius) {
     Vec3 sum{0, 0, 0};
     map.search(x, r2, [&](uint32_t i, float, float&) {
       const Photon& p = map.photons[i];
-      if (photonFacesSurface(p.direction, n)) sum += p.power;
+      if (photonFacesSurface(p.direction, n)) sum += weigh(p);
     });
     return sum * (1.0f / (kPi * r2));
   }
@@ -49,7 +56,7 @@ PVR_HOST_DEVICE Vec3 estimateFluxDensity(const PhotonMap& map, Vec3 x, Vec3 n, c
   map.search(x, r2, [&](uint32_t i, float d2, float& searchR2) {
     if (photonFacesSurface(map.photons[i].direction, n)) heap.offer(d2, i, searchR2);
   });
-  return knnFluxDensity(map, heap, params.radius * params.radius);
+  return knnFluxDensity(map, heap, params.radius * params.radius, weigh);
 }
 
 }  // namespace pvr

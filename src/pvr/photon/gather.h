@@ -2,7 +2,8 @@
 // The second pass of photon mapping: the radiance arriving at the eye along one pixel's ray,
 // written once for any Intersector (`intersect`, `occluded`) and any photon map.
 //
-// The ray follows mirrors and glass (a specular chain) to the first diffuse surface. There:
+// The ray follows mirrors and glass (a specular chain) to the first diffuse surface (or a
+// microfacet surface's gathered lobes: traceToGatherPoint). There:
 //  - ShadingMode::Full: emission + direct light by one shadow ray to a light sample + caustic and
 //    indirect light from the photon map (which then holds no direct, L D, photons);
 //  - ShadingMode::PhotonMapOnly: emission + everything else from the photon map (the main paper's
@@ -33,30 +34,90 @@ struct PixelSample {
   uint32_t reusedFrom = kNotReused;  ///< the other eye's pixel whose shading this pixel took
 };
 
-// Where an eye path meets its first diffuse surface, with everything gathered on the way except
-// the photon-map estimate there: radiance = emitted + direct light, and the estimate still to add
-// is weight * estimateFluxDensity(position, normal). Splitting here is what lets the GPU trace eye
-// rays in one kernel and estimate densities in another (the paper's hybrid scheme).
+// Where an eye path ends on a surface that gathers from the photon map, with everything gathered
+// on the way except the photon-map estimate there: radiance = emitted + direct light, and the
+// estimate still to add is weight * estimateFluxDensity(position, normal, photonContribution).
+// Splitting here is what lets the GPU trace eye rays in one kernel and estimate densities in
+// another (the paper's hybrid scheme).
+//
+// On a Lambertian surface (lobes == 0) every photon counts by its power and weight is
+// throughput * albedo / pi. On a microfacet surface the BSDF's gathered lobes are evaluated for
+// each photon's direction (view-dependent), and weight is the path's throughput.
 struct GatherPoint {
   Vec3 radiance{0, 0, 0};
-  Vec3 weight{0, 0, 0};  ///< throughput * albedo / pi; zero when the path found no diffuse surface
+  Vec3 weight{0, 0, 0};  ///< zero when the path found no surface to gather on
   Vec3 position{0, 0, 0};
   Vec3 normal{0, 0, 0};  ///< geometric normal facing the arriving ray
+  uint32_t lobes = 0;    ///< the BSDF lobes the estimate evaluates; 0: Lambertian, none evaluated
+  Vec3 wo{0, 0, 0};      ///< towards where the path came from (lobes != 0)
+  BsdfParams bsdf;       ///< (lobes != 0)
   PVR_HOST_DEVICE bool needsEstimate() const { return !isBlack(weight); }
+  // What a photon that reached the surface adds to the estimate before `weight` and 1 / (pi r^2).
+  PVR_HOST_DEVICE Vec3 photonContribution(const Photon& p) const {
+    return lobes == 0 ? p.power : bsdf.eval(wo, -p.direction, lobes) * p.power;
+  }
 };
 
-// Follows the eye ray through mirrors and glass to the first diffuse surface. `firstHit`, if
-// given, is the ray's first intersection, already traced. `coneSpread` is the ray cone's width
-// per unit distance (a pixel's, for camera rays): it chooses the textures' level of detail, and
-// grows along the path (mirrors and glass are flat).
+// Direct light from every point, spot and distant light at a surface point, one exact shadow ray
+// each (no selection noise among a handful of lights; they can never be hit by a ray). `bsdf`
+// gives f(wi) for a direction to the light; `twoSided` lets light arrive from behind (transmission).
+template <class Intersector, class Bsdf>
+PVR_HOST_DEVICE Vec3 punctualDirectLight(const SceneView& scene, const Intersector& intersector, Vec3 position,
+                                         Vec3 nGeo, Vec3 nShade, bool twoSided, float eps, const Bsdf& bsdf) {
+  Vec3 sum{0, 0, 0};
+  for (uint32_t k = 0; k < scene.punctualCount; ++k) {
+    LightSample ls;
+    ls.punctual = int(k);
+    ls.pick = 1.0f;
+    PunctualIllumination li = illuminate(scene, ls, position, eps);
+    float cosSurface = dot(nShade, li.wi), cosGeometric = dot(nGeo, li.wi);
+    bool front = cosSurface > 0.0f && cosGeometric > 0.0f;
+    bool back = twoSided && cosSurface < 0.0f && cosGeometric < 0.0f;
+    if ((!front && !back) || isBlack(li.irradiance)) continue;
+    Vec3 f = bsdf(li.wi);
+    if (isBlack(f)) continue;
+    Ray shadow{position + (front ? nGeo : -nGeo) * eps, li.wi};
+    if (!intersector.occluded(shadow, li.shadowDistance)) sum += f * li.irradiance * fabsf(cosSurface);
+  }
+  return sum;
+}
+
+// One sample of the area lights' direct light at a surface point (front side only).
+template <class Intersector, class Bsdf>
+PVR_HOST_DEVICE Vec3 areaDirectLight(const SceneView& scene, const Intersector& intersector, Vec3 position, Vec3 nGeo,
+                                     Vec3 nShade, float eps, CounterRng& rng, const Bsdf& bsdf) {
+  float uPick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+  LightSample ls = sampleAreaLight(scene, uPick, u1, u2);
+  Vec3 toLight = ls.position - position;
+  float dist2 = lengthSquared(toLight);
+  float dist = sqrtf(dist2);
+  Vec3 wi = toLight / dist;
+  float cosSurface = dot(nShade, wi), cosLight = -dot(ls.normal, wi);
+  if (!(cosSurface > 0.0f && cosLight > 0.0f && dot(nGeo, wi) > 0.0f)) return {0, 0, 0};
+  Ray shadow{position + nGeo * eps, wi};
+  if (intersector.occluded(shadow, dist * (1.0f - 1e-3f) - eps)) return {0, 0, 0};
+  return bsdf(wi) * ls.emission * (cosSurface * cosLight / (dist2 * ls.pdfArea));
+}
+
+// Follows the eye ray through mirrors and glass to a surface that gathers from the photon map.
+// `firstHit`, if given, is the ray's first intersection, already traced. `coneSpread` is the ray
+// cone's width per unit distance (a pixel's, for camera rays): it chooses the textures' level of
+// detail, and grows along the path (mirrors and glass are flat).
+//
+// On a microfacet surface the lobes split: transmission, and reflection sharper than
+// kGatheredMinAlpha, are followed by sampling the BSDF; the rest (diffuse, rough reflection) is
+// gathered there: direct light by shadow rays, the rest from the photon map with the BSDF. One
+// random choice between the two, by the lobes' probabilities, keeps one gather point per path and
+// is unbiased. Punctual lights are evaluated with the whole BSDF at every such surface.
 template <class Intersector>
-PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Intersector& intersector,
-                                           const GatherParams& params, Ray ray, CounterRng& rng,
-                                           const Hit* firstHit = nullptr, float coneSpread = 0.0f) {
+PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Intersector& intersector,
+                                               const GatherParams& params, Ray ray, CounterRng& rng,
+                                               const Hit* firstHit = nullptr, float coneSpread = 0.0f) {
   GatherPoint out;
   Vec3 throughput{1, 1, 1};
   float eps = scene.rayEpsilon();
   float coneWidth = 0.0f;
+  const bool full = params.mode == ShadingMode::Full;
   for (int depth = 0; depth <= params.maxSpecularDepth; ++depth) {
     Hit hit;
     if (depth == 0 && firstHit) hit = *firstHit;
@@ -66,46 +127,62 @@ PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Interse
     SurfacePoint sp = scene.surfacePoint(hit);
     const Material& m = scene.materials[sp.materialId];
     bool front = dot(ray.dir, sp.geometricNormal) < 0.0f;
-    if (front && m.isEmissive()) out.radiance += throughput * m.emission;
+    if (front && m.isEmissive())
+      out.radiance += throughput * scene.emissionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, sp.geometricNormal));
+    Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
     if (m.type == MaterialType::Diffuse) {
-      Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
       Vec3 nShade = front ? sp.shadingNormal : -sp.shadingNormal;
       Vec3 brdf = scene.albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo)) * kInvPi;
-      if (params.mode == ShadingMode::Full) {
-        // Every point, spot and distant light exactly (one shadow ray each), plus one sample of
-        // the area lights: unbiased, and no selection noise among a handful of lights.
-        for (uint32_t k = 0; k < scene.punctualCount; ++k) {
-          LightSample ls;
-          ls.punctual = int(k);
-          ls.pick = 1.0f;
-          PunctualIllumination li = illuminate(scene, ls, sp.position, eps);
-          float cosSurface = dot(nShade, li.wi);
-          if (cosSurface > 0.0f && dot(nGeo, li.wi) > 0.0f && !isBlack(li.irradiance)) {
-            Ray shadow{sp.position + nGeo * eps, li.wi};
-            if (!intersector.occluded(shadow, li.shadowDistance)) out.radiance += throughput * brdf * li.irradiance * cosSurface;
-          }
-        }
-      }
-      if (params.mode == ShadingMode::Full && scene.triangleLightCount > 0) {
-        float uPick = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-        LightSample ls = sampleAreaLight(scene, uPick, u1, u2);
-        Vec3 toLight = ls.position - sp.position;
-        float dist2 = lengthSquared(toLight);
-        float dist = sqrtf(dist2);
-        Vec3 wi = toLight / dist;
-        float cosSurface = dot(nShade, wi), cosLight = -dot(ls.normal, wi);
-        if (cosSurface > 0.0f && cosLight > 0.0f && dot(nGeo, wi) > 0.0f) {
-          Ray shadow{sp.position + nGeo * eps, wi};
-          if (!intersector.occluded(shadow, dist * (1.0f - 1e-3f) - eps))
-            out.radiance += throughput * brdf * ls.emission * (cosSurface * cosLight / (dist2 * ls.pdfArea));
-        }
+      auto lambertian = [&](Vec3) { return brdf; };
+      if (full) {
+        out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, nShade, false, eps, lambertian);
+        if (scene.triangleLightCount > 0)
+          out.radiance += throughput * areaDirectLight(scene, intersector, sp.position, nGeo, nShade, eps, rng, lambertian);
       }
       out.weight = throughput * brdf;
+      if (m.occlusionTexture.present()) out.weight *= scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
       out.position = sp.position;
       out.normal = nGeo;
       break;
     }
-    ray.dir = scatterSpecular(m, ray.dir, sp.shadingNormal, rng.uniform(), throughput);
+    if (m.type == MaterialType::Microfacet) {
+      const Vec3 wo = -ray.dir;
+      const BsdfParams b = scene.bsdfAt(m, hit, sp, wo, coneWidth);
+      if (full)
+        out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, b.normal, m.transmits(), eps,
+                                                         [&](Vec3 wi) { return b.eval(wo, wi); });
+      const uint32_t followed = kLobeTransmission | (b.alpha < kGatheredMinAlpha ? uint32_t(kLobeReflection) : 0u);
+      float p[3];
+      b.lobeProbabilities(dot(b.normal, wo), kLobesAll, p);
+      const float pFollow = ((followed & kLobeReflection) ? p[1] : 0.0f) + p[2];
+      bool follow = pFollow >= 1.0f;
+      if (pFollow > 0.0f && pFollow < 1.0f) follow = rng.uniform() < pFollow;
+      if (!follow) {
+        const uint32_t gathered = kLobesAll & ~followed;
+        const Vec3 scale = throughput * (1.0f / (1.0f - pFollow));
+        if (full && scene.triangleLightCount > 0)
+          out.radiance += scale * areaDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng,
+                                                  [&](Vec3 wi) { return b.eval(wo, wi, gathered); });
+        out.weight = scale;
+        if (m.occlusionTexture.present()) out.weight *= scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
+        out.position = sp.position;
+        out.normal = nGeo;
+        out.lobes = gathered;
+        out.wo = wo;
+        out.bsdf = b;
+        break;
+      }
+      // Three statements: the order of evaluation of arguments differs between g++ and nvcc.
+      float uLobe = rng.uniform();
+      float u1 = rng.uniform();
+      float u2 = rng.uniform();
+      BsdfSample bs = sampleBsdf(b, wo, uLobe, u1, u2, followed);
+      if (!bs.valid()) break;
+      throughput *= bs.weight * (1.0f / pFollow);
+      ray.dir = bs.wi;
+    } else {
+      ray.dir = scatterSpecular(m, ray.dir, sp.shadingNormal, rng.uniform(), throughput);
+    }
     Vec3 side = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
     ray.origin = sp.position + side * eps;
   }
@@ -116,14 +193,15 @@ PVR_HOST_DEVICE GatherPoint traceToDiffuse(const SceneView& scene, const Interse
 template <class PhotonMap>
 PVR_HOST_DEVICE Vec3 finishGather(const PhotonMap& map, const GatherPoint& point, const DensityParams& density) {
   if (!point.needsEstimate()) return point.radiance;
-  return point.radiance + point.weight * estimateFluxDensity(map, point.position, point.normal, density);
+  auto contribution = [&](const Photon& p) { return point.photonContribution(p); };
+  return point.radiance + point.weight * estimateFluxDensity(map, point.position, point.normal, density, contribution);
 }
 
 // Radiance arriving along one eye ray.
 template <class Intersector, class PhotonMap>
 PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
                                       const GatherParams& params, Ray ray, CounterRng& rng) {
-  return finishGather(map, traceToDiffuse(scene, intersector, params, ray, rng), params.density);
+  return finishGather(map, traceToGatherPoint(scene, intersector, params, ray, rng), params.density);
 }
 
 // The random numbers of sample s of one pixel of one eye.
@@ -162,7 +240,7 @@ PVR_HOST_DEVICE GatherPoint imagePositionGatherPoint(const SceneView& scene, con
   Hit first;
   intersector.intersect(ray, INFINITY, first);
   inverseDepth = firstHitInverseDepth(camera, ray, first);
-  return traceToDiffuse(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
+  return traceToGatherPoint(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
 }
 
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
@@ -192,7 +270,7 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   }
   CounterRng rng(0, 0, 0);
   Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
-  if (s > 0) return traceToDiffuse(scene, intersector, params, ray, rng, nullptr, camera.pixelSpread());
+  if (s > 0) return traceToGatherPoint(scene, intersector, params, ray, rng, nullptr, camera.pixelSpread());
   Hit first;
   intersector.intersect(ray, INFINITY, first);
   pixel.firstPrim = first.primId;
@@ -205,7 +283,7 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
       return reused;
     }
   }
-  return traceToDiffuse(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
+  return traceToGatherPoint(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
 }
 
 // A foveation mask vertex at image position (px, py). On a pixel centre (all of the mask's

@@ -8,8 +8,9 @@
 // a spot: uniform within the outer cone, weighted by its falloff; a distant light: a uniform point
 // on a disk as wide as the scene's bounding sphere, upstream of it, carrying E pi R^2 / (pick N). At a diffuse surface the photon is stored, then
 // continues with Russian roulette (probability = max albedo component, power scaled so the
-// expectation is unchanged). Mirrors reflect and glass reflects or refracts (by Fresnel); photons
-// are never stored on them.
+// expectation is unchanged). A microfacet surface stores the photon too, then samples its whole
+// BSDF (shading/bsdf.h), with Russian roulette on the sample's weight. Mirrors reflect and glass
+// reflects or refracts (by Fresnel); photons are never stored on them.
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/photon/photon.h"
 #include "pvr/shading/scene_view.h"
@@ -81,7 +82,25 @@ PVR_HOST_DEVICE int tracePhoton(const SceneView& scene, const Intersector& inter
     const Material& m = scene.materials[sp.materialId];
     CounterRng rng(params.seed, i, uint32_t(depth) + 1);
     Vec3 dir = ray.dir;
-    if (m.type == MaterialType::Diffuse) {
+    if (m.type == MaterialType::Microfacet) {
+      if (depth > 0 || params.storeDirect) {
+        Photon& s = out[stored++];
+        s.position = sp.position;
+        s.power = photon.power;
+        s.direction = dir;
+      }
+      // Three statements: the order of evaluation of arguments differs between g++ and nvcc.
+      float uLobe = rng.uniform();
+      float u1 = rng.uniform();
+      float u2 = rng.uniform();
+      BsdfSample bs = sampleBsdf(scene.bsdfAt(m, hit, sp, -dir), -dir, uLobe, u1, u2);
+      if (!bs.valid()) break;
+      float survive = fminf(1.0f, maxComponent(bs.weight));
+      if (!(rng.uniform() < survive)) break;
+      photon.power *= bs.weight * (1.0f / survive);
+      ray.dir = bs.wi;
+      offsetNormal = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
+    } else if (m.type == MaterialType::Diffuse) {
       Vec3 nFacing = dot(dir, sp.geometricNormal) < 0.0f ? sp.geometricNormal : -sp.geometricNormal;
       Vec3 nShade = dot(sp.shadingNormal, nFacing) < 0.0f ? -sp.shadingNormal : sp.shadingNormal;
       bool direct = depth == 0;  // L D: shaded by shadow rays unless the map shades alone

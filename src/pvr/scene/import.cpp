@@ -1,11 +1,16 @@
 // Mesh import through assimp. Material mapping:
-//   glTF 2.0: baseColorFactor (x baseColorTexture) -> diffuse albedo; emissiveFactor -> Le;
-//             metallic >= 0.5 with roughness <= 0.1 -> mirror (reflectance = base colour);
-//             KHR_materials_transmission >= 0.5 -> glass (ior from KHR_materials_ior, default 1.5);
-//             alphaMode MASK / BLEND with alphaCutoff -> alpha-tested cut-outs.
+//   glTF 2.0: the microfacet material (shading/bsdf.h): baseColorFactor x baseColorTexture,
+//             metallicFactor and roughnessFactor x metallicRoughnessTexture (B, G),
+//             KHR_materials_transmission and KHR_materials_ior, emissiveFactor x emissiveTexture
+//             -> Le, occlusionTexture; exactly smooth metal (metallic 1, roughness 0, no texture)
+//             -> mirror, exactly smooth full transmission -> glass; alphaMode MASK / BLEND with
+//             alphaCutoff -> alpha-tested cut-outs.
 //   OBJ/MTL:  Kd (x map_Kd) -> albedo; Ke -> Le; illum 3 or 5 -> mirror (reflectance Ks, else Kd);
-//             illum 4, 6, 7 or 9, or d < 0.5 without map_d -> glass (ior Ni); map_d -> cut-out.
-//   3DS:      diffuse colour (x its texture map) -> albedo.
+//             illum 4, 6, 7 or 9, or d < 0.5 without map_d -> glass (ior Ni); map_d -> cut-out;
+//             Ks (x map_Ks) with illum 2 (or none) -> a glossy dielectric layer of F0 = max(Ks)
+//             and roughness from Ns (x map_Ns), alpha = sqrt(2 / (Ns + 2)) (Blinn-Phong's match).
+//   3DS:      diffuse colour (x its texture map) -> albedo; specular colour and shininess as
+//             OBJ's Ks and Ns.
 // Texture coordinates are taken with assimp's FlipUVs, so v runs down the image as the texels do.
 #include <assimp/GltfMaterial.h>
 #include <assimp/ObjMaterial.h>
@@ -68,6 +73,51 @@ TextureRef textureOf(const aiScene& as, const aiMaterial& am, aiTextureType type
   return ref;
 }
 
+// glTF's metallic-roughness material; exactly smooth metal or glass without textures become the
+// delta materials, which need no sampling.
+void microfacetFromGltf(const aiScene& as, const aiMaterial& am, float metallic, float roughness, float transmission,
+                        float ior, const std::string& folder, TextureLoader& textures, Material& m) {
+  auto unit = [](float x, float fallback) { return std::isfinite(x) ? std::clamp(x, 0.0f, 1.0f) : fallback; };
+  m.metallic = unit(metallic, 0.0f);
+  m.roughness = unit(roughness, 1.0f);
+  m.transmission = unit(transmission, 0.0f);
+  m.ior = ior;
+  float f = (ior - 1.0f) / (ior + 1.0f);
+  m.specularF0 = f * f;
+  // assimp 5.2 files glTF's metallicRoughnessTexture as UNKNOWN and occlusionTexture as LIGHTMAP.
+  m.metallicRoughnessTexture = textureOf(as, am, aiTextureType_UNKNOWN, false, folder, textures);
+  m.emissiveTexture = textureOf(as, am, aiTextureType_EMISSIVE, true, folder, textures);
+  m.occlusionTexture = textureOf(as, am, aiTextureType_LIGHTMAP, false, folder, textures);
+  if (m.occlusionTexture.present()) {
+    float strength = 1.0f;
+    if (am.Get(AI_MATKEY_GLTF_TEXTURE_STRENGTH(aiTextureType_LIGHTMAP, 0), strength) == AI_SUCCESS && std::isfinite(strength))
+      m.occlusionStrength = std::clamp(strength, 0.0f, 1.0f);
+  }
+  m.type = MaterialType::Microfacet;
+  if (m.roughness == 0.0f && !m.metallicRoughnessTexture.present()) {
+    if (m.metallic == 1.0f) m.type = MaterialType::Mirror;
+    else if (m.metallic == 0.0f && m.transmission == 1.0f) m.type = MaterialType::Glass;
+  }
+}
+
+// OBJ/MTL and 3DS: a Phong specular colour and exponent become a glossy dielectric layer.
+void glossyLayerFromPhong(const aiScene& as, const aiMaterial& am, int illum, const std::string& folder,
+                          TextureLoader& textures, Material& m) {
+  aiColor3D ks(0, 0, 0);
+  float shininess = 0.0f;
+  am.Get(AI_MATKEY_COLOR_SPECULAR, ks);
+  am.Get(AI_MATKEY_SHININESS, shininess);
+  float f0 = std::max({ks.r, ks.g, ks.b});
+  if (illum == 0 || illum == 1 || !std::isfinite(f0) || !(f0 > 0.0f)) return;  // no highlights
+  if (!std::isfinite(shininess) || shininess < 0.0f) shininess = 0.0f;
+  m.type = MaterialType::Microfacet;
+  m.specularF0 = std::min(f0, 1.0f);
+  m.roughness = std::sqrt(std::sqrt(2.0f / (shininess + 2.0f)));  // alpha = roughness^2
+  m.specularTexture = textureOf(as, am, aiTextureType_SPECULAR, false, folder, textures);
+  m.shininessTexture = textureOf(as, am, aiTextureType_SHININESS, false, folder, textures);
+  m.shininess = shininess;
+}
+
 Material convertMaterial(const aiScene& as, const aiMaterial& am, const std::string& folder, TextureLoader& textures) {
   Material m;
   aiColor3D color(0.8f, 0.8f, 0.8f);
@@ -115,19 +165,21 @@ Material convertMaterial(const aiScene& as, const aiMaterial& am, const std::str
     m.alpha = std::isfinite(opacity) ? std::clamp(opacity, 0.0f, 1.0f) : 1.0f;
   }
   if (!(m.alphaCutoff >= 0.0f && m.alphaCutoff <= 1.0f)) m.alphaCutoff = 0.5f;
-  if (transmission >= 0.5f || objGlass || (!gltf && opacity < 0.5f && !m.opacityTexture.present())) {
+  if (!gltf && (objGlass || (opacity < 0.5f && !m.opacityTexture.present()))) {
     m.type = MaterialType::Glass;
     m.ior = ior;
     aiColor3D tint(1, 1, 1);
     if (am.Get(AI_MATKEY_COLOR_TRANSPARENT, tint) == AI_SUCCESS && (tint.r + tint.g + tint.b) > 0) m.albedo = toVec3(tint);
     else m.albedo = {1, 1, 1};
-  } else if ((metallic >= 0.5f && roughness <= 0.1f) || illum == 3 || illum == 5) {
+  } else if (illum == 3 || illum == 5) {
     m.type = MaterialType::Mirror;
     aiColor3D specular(0, 0, 0);
-    if ((illum == 3 || illum == 5) && am.Get(AI_MATKEY_COLOR_SPECULAR, specular) == AI_SUCCESS &&
-        (specular.r + specular.g + specular.b) > 0)
+    if (am.Get(AI_MATKEY_COLOR_SPECULAR, specular) == AI_SUCCESS && (specular.r + specular.g + specular.b) > 0)
       m.albedo = toVec3(specular);
+  } else if (!gltf) {
+    glossyLayerFromPhong(as, am, illum, folder, textures, m);
   }
+  if (gltf) microfacetFromGltf(as, am, metallic, roughness, transmission, ior, folder, textures, m);
   for (int c = 0; c < 3; ++c) {  // energy conservation and sanity
     m.albedo[c] = std::clamp(std::isfinite(m.albedo[c]) ? m.albedo[c] : 0.0f, 0.0f, 1.0f);
     if (!std::isfinite(m.emission[c]) || m.emission[c] < 0) m.emission[c] = 0;

@@ -1,13 +1,15 @@
 #pragma once
-// Surface materials: Lambertian diffuse (where photons are stored), perfect mirror and smooth
-// dielectric (glass). Any material may also emit (an area light). The colour may come from a
-// texture (times the constant factor), and an alpha mask may cut texels out of the surface.
+// Surface materials: Lambertian diffuse, perfect mirror, smooth dielectric (glass), and glTF's
+// metallic-roughness microfacet material (shading/bsdf.h: GGX metals, glossy dielectrics, rough
+// glass). Photons are stored on every surface that is not a mirror or smooth glass. Any material
+// may also emit (an area light). Factors may be multiplied by textures, and an alpha mask may cut
+// texels out of the surface.
 #include "pvr/math/vec.h"
 #include "pvr/shading/texture.h"
 
 namespace pvr {
 
-enum class MaterialType : uint32_t { Diffuse = 0, Mirror = 1, Glass = 2 };
+enum class MaterialType : uint32_t { Diffuse = 0, Mirror = 1, Glass = 2, Microfacet = 3 };
 
 // glTF's alphaMode. BLEND is treated as MASK at the cutoff (a ray tracer's surfaces are opaque
 // or absent; stochastic transparency would be noisier, not more right): docs/scene-format.md.
@@ -17,7 +19,19 @@ struct Material {
   MaterialType type = MaterialType::Diffuse;
   Vec3 albedo{0.8f, 0.8f, 0.8f};  ///< diffuse albedo, mirror reflectance or glass transmittance tint
   Vec3 emission{0, 0, 0};         ///< emitted radiance Le from the front face (W / m^2 / sr)
-  float ior = 1.5f;               ///< index of refraction (glass only)
+  float ior = 1.5f;               ///< index of refraction (glass, microfacet transmission)
+  // Microfacet only (glTF's metallic-roughness model):
+  float metallic = 0.0f;
+  float roughness = 1.0f;         ///< perceptual roughness; GGX alpha = roughness^2
+  float transmission = 0.0f;      ///< KHR_materials_transmission: the non-metal's share that refracts
+  float specularF0 = 0.04f;       ///< dielectric reflectance at normal incidence (from the ior, or OBJ Ks)
+  float occlusionStrength = 1.0f; ///< glTF occlusionTexture.strength
+  TextureRef metallicRoughnessTexture;  ///< roughness in G, metallic in B (glTF), multiplying the factors
+  TextureRef emissiveTexture;     ///< multiplies emission (RGB)
+  TextureRef occlusionTexture;    ///< baked ambient occlusion (R): darkens the photon-map term only
+  TextureRef specularTexture;     ///< OBJ map_Ks: multiplies specularF0 (its luminance)
+  TextureRef shininessTexture;    ///< OBJ map_Ns: multiplies the Phong exponent (R, 0..1)
+  float shininess = 0.0f;         ///< the Phong exponent Ns that map_Ns scales
   TextureRef baseColorTexture;    ///< multiplies albedo (RGB) and alpha (A)
   TextureRef opacityTexture;      ///< OBJ's map_d: alpha from its first channel
   TextureRef normalTexture;       ///< tangent-space normal map (glTF's convention: +X along +u, +Y up the image)
@@ -28,8 +42,13 @@ struct Material {
 
   PVR_HOST_DEVICE bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 
-  PVR_HOST_DEVICE bool isSpecular() const { return type != MaterialType::Diffuse; }
+  /// A mirror or smooth glass: a delta BSDF, followed by the paths, never storing photons.
+  PVR_HOST_DEVICE bool isSpecular() const { return type == MaterialType::Mirror || type == MaterialType::Glass; }
+  /// Sends the same radiance in every direction (Lambertian): what stereo reuse may share.
+  PVR_HOST_DEVICE bool isViewIndependent() const { return type == MaterialType::Diffuse; }
   PVR_HOST_DEVICE bool isEmissive() const { return !isBlack(emission); }
+  /// Microfacet materials with a refracting share need rays and lights from both sides.
+  PVR_HOST_DEVICE bool transmits() const { return type == MaterialType::Microfacet && transmission > 0.0f; }
 };
 
 // Unpolarized Fresnel reflectance of a smooth dielectric; cosI > 0, eta = n_incident / n_transmitted.

@@ -3,6 +3,7 @@
 // indexed triangles, optional per-vertex normals, per-triangle materials, and the emitting
 // triangles with a power-proportional CDF for light sampling and photon emission.
 #include "pvr/geometry/ray.h"
+#include "pvr/shading/bsdf.h"
 #include "pvr/shading/material.h"
 #include "pvr/util/sampling.h"
 
@@ -171,6 +172,64 @@ struct SceneView {
     return m.albedo * sampleRef(m.baseColorTexture, prim, u, v, lod).rgb;
   }
 
+  // A microfacet material's BSDF at a hit seen from wo (unit, away from the surface), its factors
+  // multiplied by their textures at the level a ray cone `coneWidth` wide picks. The shading
+  // normal is turned to wo's side (every surface is two-sided); one bent past wo by a normal map or
+  // interpolation falls back to the geometric normal. Transmission takes the ior on the side wo is not.
+  PVR_HOST_DEVICE BsdfParams bsdfAt(const Material& m, const Hit& hit, const SurfacePoint& sp, Vec3 wo,
+                                    float coneWidth = 0.0f) const {
+    BsdfParams b;
+    const bool outside = dot(wo, sp.geometricNormal) > 0.0f;
+    const Vec3 nGeo = outside ? sp.geometricNormal : -sp.geometricNormal;
+    b.normal = outside ? sp.shadingNormal : -sp.shadingNormal;
+    if (!(dot(b.normal, wo) > 1e-4f)) b.normal = nGeo;
+    const float cosTheta = dot(wo, nGeo);
+    b.baseColor = albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, cosTheta);
+    float metallic = m.metallic, roughness = m.roughness;
+    if (m.metallicRoughnessTexture.present()) {
+      float lod = textureLod(m.metallicRoughnessTexture, hit.primId, coneWidth, cosTheta);
+      Vec3 t = sampleRef(m.metallicRoughnessTexture, hit.primId, hit.u, hit.v, lod).rgb;
+      roughness *= t.y;
+      metallic *= t.z;
+    }
+    if (m.shininessTexture.present()) {  // OBJ map_Ns: Blinn-Phong's exponent, matched as alpha = sqrt(2 / (Ns + 2))
+      float lod = textureLod(m.shininessTexture, hit.primId, coneWidth, cosTheta);
+      float ns = m.shininess * sampleRef(m.shininessTexture, hit.primId, hit.u, hit.v, lod).rgb.x;
+      roughness = sqrtf(sqrtf(2.0f / (fmaxf(ns, 0.0f) + 2.0f)));
+    }
+    b.specularF0 = m.specularF0;
+    if (m.specularTexture.present()) {
+      float lod = textureLod(m.specularTexture, hit.primId, coneWidth, cosTheta);
+      b.specularF0 *= luminance(sampleRef(m.specularTexture, hit.primId, hit.u, hit.v, lod).rgb);
+    }
+    b.metallic = fminf(fmaxf(metallic, 0.0f), 1.0f);
+    roughness = fminf(fmaxf(roughness, 0.0f), 1.0f);
+    b.alpha = fmaxf(kMinGgxAlpha, roughness * roughness);
+    b.transmission = m.transmission;
+    if (m.transmits()) {
+      b.etaO = outside ? 1.0f : m.ior;
+      b.etaI = outside ? m.ior : 1.0f;
+    }
+    return b;
+  }
+
+  // Emitted radiance at a point of an emitter's front face: the factor times its emissive texture.
+  PVR_HOST_DEVICE Vec3 emissionAt(const Material& m, uint32_t prim, float u, float v, float coneWidth = 0.0f,
+                                  float cosTheta = 1.0f) const {
+    if (!m.emissiveTexture.present()) return m.emission;
+    float lod = textureLod(m.emissiveTexture, prim, coneWidth, cosTheta);
+    return m.emission * sampleRef(m.emissiveTexture, prim, u, v, lod).rgb;
+  }
+
+  // glTF's ambient occlusion factor 1 + strength (texel - 1), 1 without a texture.
+  PVR_HOST_DEVICE float occlusionAt(const Material& m, uint32_t prim, float u, float v, float coneWidth = 0.0f,
+                                    float cosTheta = 1.0f) const {
+    if (!m.occlusionTexture.present()) return 1.0f;
+    float lod = textureLod(m.occlusionTexture, prim, coneWidth, cosTheta);
+    float ao = sampleRef(m.occlusionTexture, prim, u, v, lod).rgb.x;
+    return fminf(fmaxf(1.0f + m.occlusionStrength * (ao - 1.0f), 0.0f), 1.0f);
+  }
+
   // Alpha masking: false where the material cuts the surface out (rays pass through). Read at the
   // finest level, the same for eye, shadow and photon rays.
   PVR_HOST_DEVICE bool alphaPasses(uint32_t prim, float u, float v) const {
@@ -217,7 +276,7 @@ PVR_HOST_DEVICE inline LightSample sampleLight(const SceneView& s, float uPick, 
   float area = 0.5f * length(cross(b - a, c - a));
   ls.position = a * (1.0f - bc.x - bc.y) + b * bc.x + c * bc.y;
   ls.normal = s.faceNormal(prim, a, b, c);
-  ls.emission = s.material(prim).emission;
+  ls.emission = s.emissionAt(s.material(prim), prim, bc.x, bc.y);
   ls.pdfArea = pick / area;
   return ls;
 }
@@ -237,7 +296,7 @@ PVR_HOST_DEVICE inline LightSample sampleAreaLight(const SceneView& s, float uPi
   ls.pick = pick;
   ls.position = a * (1.0f - bc.x - bc.y) + b * bc.x + c * bc.y;
   ls.normal = s.faceNormal(prim, a, b, c);
-  ls.emission = s.material(prim).emission;
+  ls.emission = s.emissionAt(s.material(prim), prim, bc.x, bc.y);
   ls.pdfArea = pick / area;
   return ls;
 }

@@ -35,8 +35,8 @@ constexpr uint32_t kNotReused = ~0u;            ///< a pixel shaded by its own e
 constexpr uint64_t kNothingScattered = ~0ull;  ///< scatter buffer entry no left point reached
 constexpr float kSameSurfaceCosine = 0.95f;     ///< normals closer than ~18 degrees agree
 
-// The first hit of a pixel's centre ray when it is a diffuse surface reached directly (no mirror
-// or glass before it): what the other eye may reuse. prim == ~0u when there is none.
+// The first hit of a pixel's centre ray when it is a Lambertian surface reached directly (no
+// mirror or glass before it; microfacet surfaces are view-dependent): what the other eye may reuse. prim == ~0u when there is none.
 struct SurfaceRecord {
   Vec3 position{0, 0, 0};
   uint32_t prim = ~0u;
@@ -63,7 +63,7 @@ PVR_HOST_DEVICE inline float pixelFootprint(const EyeCamera& camera, Vec3 positi
 PVR_HOST_DEVICE inline SurfaceRecord surfaceRecordOf(const SceneView& scene, const EyeCamera& camera, const Ray& ray,
                                                      const Hit& hit) {
   SurfaceRecord record;
-  if (!hit.valid() || scene.material(hit.primId).isSpecular()) return record;
+  if (!hit.valid() || !scene.material(hit.primId).isViewIndependent()) return record;
   SurfacePoint sp = scene.surfacePoint(hit);
   record.position = sp.position;
   record.normal = dot(ray.dir, sp.geometricNormal) < 0.0f ? sp.geometricNormal : -sp.geometricNormal;
