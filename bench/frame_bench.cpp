@@ -1,6 +1,7 @@
 #include "frame_bench.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include "bench_util.h"
 #include "pvr/util/latency_stats.h"
 #include "pvr/util/error.h"
+#include "pvr/util/parallel_for.h"
 #ifdef PVR_HAVE_CUDA
 #include "gpu_ray_throughput.h"
 #include "pvr/cuda/cuda_frame_backend.h"
@@ -683,6 +685,52 @@ int runGrid(const FrameBenchArgs& args, nlohmann::json& json) {
 
 }  // namespace
 
+// Rays a frame casts, counted on the CPU by the shared algorithm code over a counting Embree
+// intersector: every backend casts the same rays (the GPU is checked against the CPU), so
+// dividing by a backend's stage times gives its rays per second.
+struct CountingIntersector {
+  const EmbreeIntersector& inner;
+  mutable std::atomic<uint64_t> closest{0}, shadow{0};
+  bool intersect(const Ray& ray, float tMax, Hit& hit) const {
+    closest.fetch_add(1, std::memory_order_relaxed);
+    return inner.intersect(ray, tMax, hit);
+  }
+  bool occluded(const Ray& ray, float tMax) const {
+    shadow.fetch_add(1, std::memory_order_relaxed);
+    return inner.occluded(ray, tMax);
+  }
+};
+
+struct FrameRays {
+  uint64_t photon = 0;  ///< photon paths' segments
+  uint64_t eye = 0;     ///< both eyes: camera and specular-chain rays plus shadow rays
+};
+
+// The rays of a separate (no reuse) full-resolution frame with options o.
+FrameRays countFrameRays(const Scene& scene, const StereoRig& rig, const RenderOptions& o) {
+  CpuBackend backend(scene);
+  SceneView view = scene.view();
+  FrameRays rays;
+  CountingIntersector photonCounter{backend.intersector()};
+  const PhotonTraceParams tp = o.photonTraceParams();
+  parallelFor("count photon rays", tp.photonCount, 4096, [&](size_t begin, size_t end) {
+    std::vector<Photon> buffer(size_t(tp.maxDepth));
+    for (size_t i = begin; i < end; ++i) tracePhoton(view, photonCounter, tp, uint32_t(i), buffer.data());
+  });
+  rays.photon = photonCounter.closest + photonCounter.shadow;
+  HashGrid grid = HashGrid::build(backend.tracePhotons(tp), o.gather.density.radius);
+  CountingIntersector eyeCounter{backend.intersector()};
+  for (Eye eye : {Eye::Left, Eye::Right}) {
+    const EyeCamera camera = rig.eye(eye);
+    parallelForTiles("count eye rays", camera.height, camera.width, 16, [&](int y0, int y1, int x0, int x1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) shadePixel(view, eyeCounter, grid.view(), o.gather, camera, eye, x, y);
+    });
+  }
+  rays.eye = eyeCounter.closest + eyeCounter.shadow;
+  return rays;
+}
+
 // Textured scenes with full shading (the real-time configuration): separate and gather frames,
 // the same gather frame without colour textures (what sampling costs), and each image's error
 // against the separate frame with 16x the photons (the converged reference at this radius).
@@ -707,9 +755,13 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
     std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
     std::unique_ptr<FrameRenderer> plainRenderer = makeFrameRenderer(kind, plain);
     const float diagonal = length(scene.bounds().extent());
+    // The built-in boxes (the per-ray yardstick) keep the paper's radius; the cathedrals take --scene-radius.
+    const std::vector<std::string> builtins = builtinSceneNames();
+    const bool builtin = std::find(builtins.begin(), builtins.end(), name) != builtins.end();
+    const float radius = builtin ? RenderOptions().gather.density.radius : args.sceneRadius;
     RenderOptions o;
     o.photonsX = o.photonsY = 512;
-    o.gather.density.radius = args.sceneRadius;
+    o.gather.density.radius = radius;
     o.gather.mode = ShadingMode::Full;
     RenderOptions reference = o;
     reference.photonsX = reference.photonsY = 2048;
@@ -722,8 +774,10 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
     const Cell cells[] = {{"separate", renderer.get(), StereoMode::Separate},
                           {"gather", renderer.get(), StereoMode::Gather},
                           {"gather, no colour textures", plainRenderer.get(), StereoMode::Gather}};
+    const FrameRays rays = countFrameRays(scene, rig, o);
     double eyePassMs[3] = {0, 0, 0};
-    for (int c = 0; c < 3; ++c) {
+    const int cellCount = scene.textureCount() > 0 ? 3 : 2;  // no textures: nothing to leave out
+    for (int c = 0; c < cellCount; ++c) {
       RenderOptions co = o;
       co.stereo = cells[c].stereo;
       CellResult r = timeCell(*cells[c].renderer, rig, co, args.warmup, args.frames);
@@ -735,16 +789,26 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
       bool ok = c < 2 ? error[0] < 0.5 && error[1] < 0.5 : error[0] > 0.01;
       failures += ok ? 0 : 1;
       std::printf("| %s | %dx%d | 512x512 | %g (%.2f %%) | %s | %s | %s | %s | %s | %s | %.3f / %.3f | %s |\n",
-                  scene.name.c_str(), rig.width, rig.height, args.sceneRadius, 100.0 * args.sceneRadius / diagonal,
+                  scene.name.c_str(), rig.width, rig.height, radius, 100.0 * radius / diagonal,
                   cells[c].name, meanP99(r.frame, 2).c_str(), meanP99(r.stages.trace, 2).c_str(),
                   meanP99(r.stages.build, 2).c_str(), meanP99(r.stages.eye[0], 2).c_str(), meanP99(r.stages.eye[1], 2).c_str(),
                   error[0], error[1], ok ? "ok" : "MISMATCH");
       nlohmann::json cell = r.latencyJson();
       cell.update({{"suite", "scenes"}, {"scene", scene.name}, {"variant", cells[c].name}, {"backend", renderer->name()},
                    {"device", renderer->deviceName()}, {"eye_size", {rig.width, rig.height}}, {"photons", 512 * 512},
-                   {"radius", args.sceneRadius}, {"radius_of_diagonal", args.sceneRadius / diagonal},
+                   {"radius", radius}, {"radius_of_diagonal", radius / diagonal},
                    {"triangles", scene.triangleCount()}, {"textures", scene.textureCount()},
                    {"error_vs_16x_photons", {error[0], error[1]}}, {"check", ok ? "ok" : "MISMATCH"}});
+      if (c == 0) {  // rays per second of the separate frame's stages (mean stage times)
+        const double traceS = r.stages.trace.mean * 1e-3, eyeS = (r.stages.eye[0].mean + r.stages.eye[1].mean) * 1e-3;
+        const double photonRate = traceS > 0 ? double(rays.photon) / traceS : 0.0;
+        const double eyeRate = eyeS > 0 ? double(rays.eye) / eyeS : 0.0;
+        std::printf("| %s | rays per frame: %.2f M photon, %.2f M eye (camera, specular chains, shadow); photon trace "
+                    "%.0f Mrays/s, eye pass %.0f Mrays/s (density estimates included) |\n",
+                    scene.name.c_str(), rays.photon * 1e-6, rays.eye * 1e-6, photonRate * 1e-6, eyeRate * 1e-6);
+        cell.update({{"photon_rays", rays.photon}, {"eye_rays", rays.eye}, {"photon_trace_rays_per_s", photonRate},
+                     {"eye_pass_rays_per_s", eyeRate}});
+      }
       json.push_back(cell);
     }
     if (eyePassMs[2] > 0)

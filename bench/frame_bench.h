@@ -27,7 +27,7 @@ struct FrameBenchArgs {
   std::string stereo = "separate,scatter,gather";  ///< Table 5's columns
   std::string stereoScenes = "cornell,cornell-caustics";  ///< Table 5 on the first; the others: one row
   std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
-  std::string scenes = "scenes/dabrovic-sponza.json,scenes/sibenik.json";  ///< scenes suite; absent meshes: skipped
+  std::string scenes = "scenes/dabrovic-sponza.json,scenes/sibenik.json,cornell-dense";  ///< scenes suite (cornell-dense: the per-ray yardstick); absent meshes: skipped
   float sceneRadius = 0.15f;  ///< scenes suite: the search radius, scene units
   int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)
   int warmup = 10;

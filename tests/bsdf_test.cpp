@@ -145,6 +145,29 @@ TEST(Bsdf, WhiteRoughMetalHeadOnKeepsOneMinusLnTwo) {
   EXPECT_NEAR(sum / n, 1.0 - std::log(2.0), 2e-3);
 }
 
+// Extreme parameters (a layer reflecting everything, the sharpest lobe, grazing and total internal
+// reflection) give finite values everywhere: one NaN photon blackens a whole disk of the image.
+TEST(Bsdf, ExtremeParametersStayFinite) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  for (float f0 : {0.0f, 1.0f})
+    for (float roughness : {0.0f, 1.0f})
+      for (float metallic : {0.0f, 1.0f})
+        for (float transmission : {0.0f, 1.0f})
+          for (bool inside : {false, true}) {
+            BsdfParams b = paramsOf(Config{"extreme", metallic, roughness, transmission, f0, inside});
+            for (int k = 0; k < 2000; ++k) {
+              Vec3 wo = directionAt(b, k == 0 ? 1e-6f : u01(rng), 2 * kPi * u01(rng));
+              Vec3 wi = directionAt(b, 2 * u01(rng) - 1, 2 * kPi * u01(rng));
+              ASSERT_TRUE(isFinite(b.eval(wo, wi))) << f0 << " " << roughness << " " << metallic << " " << transmission;
+              ASSERT_TRUE(std::isfinite(b.pdf(wo, wi)));
+              float uLobe = u01(rng), u1 = u01(rng), u2 = u01(rng);
+              BsdfSample s = sampleBsdf(b, wo, uLobe, u1, u2);
+              ASSERT_TRUE(isFinite(s.weight) && std::isfinite(s.pdf));
+            }
+          }
+}
+
 // Reflection is reciprocal; transmission (importance form) obeys f(o, i) / eta_i^2 = f(i, o) / eta_o^2.
 TEST(Bsdf, ReciprocityOfReflectionAndTransmission) {
   std::mt19937 rng(3);
@@ -321,3 +344,4 @@ TEST(Bsdf, MicrofacetFirstHitsAreNotReusedBetweenEyes) {
 
 }  // namespace
 }  // namespace pvr
+

@@ -36,6 +36,10 @@ expect_error "unsupported scene format" render "$data/not_a_scene.txt" "${small[
 expect_error "malformed JSON" render "$data/malformed.json" "${small[@]}"
 expect_error "cannot read" render "$data/malformed.gltf" "${small[@]}"
 expect_error "no light" render "$data/no_light.json" "${small[@]}"
+echo '{"base": "cornell", "lights": [{"sky": [-1, 0, 0]}]}' >"$out/negative_sky.json"
+expect_error "radiance must not be negative" render "$out/negative_sky.json" "${small[@]}"
+echo '{"base": "cornell", "lights": [{"sky": [1, 1, 1], "aim_radius": 2}]}' >"$out/half_aimed_sky.json"
+expect_error "needs both aim_center and aim_radius" render "$out/half_aimed_sky.json" "${small[@]}"
 expect_error "photons must be" render cornell --photons 0 --eye-size 8x8
 expect_error "--backend must be" render cornell --backend gpu --eye-size 8x8
 expect_error "--kernel must be" render cornell --kernel fused --eye-size 8x8

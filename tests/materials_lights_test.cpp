@@ -252,6 +252,52 @@ TEST(Lights, PhotonMapAgreesWithTheDirectIrradiance) {
   }
 }
 
+// A white floor under a uniform sky L (aimed at a sphere holding the floor): irradiance pi L, so
+// the radiance is L, exactly by the cosine-sampled shadow ray and within noise from the photons.
+// Rays that escape upwards see L, downwards nothing.
+TEST(Lights, UniformSkyLightsAnOpenFloorWithItsRadiance) {
+  Scene scene;
+  Material white;
+  white.albedo = {1, 1, 1};
+  uint32_t id = scene.addMaterial(white, "floor");
+  scene.addMesh("floor", {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}}, {}, {0, 2, 1, 0, 3, 2}, id);
+  SkyLight sky;
+  sky.radiance = {0.5f, 1.0f, 2.0f};
+  sky.aimCenter = {0, 0, 0};
+  sky.aimRadius = 1.5f;
+  scene.setSky(sky);
+  scene.finalize();
+  CpuBackend backend(scene);
+  SceneView view = scene.view();
+  GatherParams full;
+  for (int k = 0; k < 4; ++k) {
+    Ray down{{0.2f * k, 1.0f, 0.1f}, normalize(Vec3(0.1f, -1.0f, 0.05f))};
+    CounterRng rng(3, uint32_t(k), 0);
+    GatherPoint gp = traceToGatherPoint(view, backend.intersector(), full, down, rng);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(gp.radiance[c], sky.radiance[c], 1e-5f);
+  }
+  CounterRng rng(1, 0, 0);
+  Vec3 up = traceToGatherPoint(view, backend.intersector(), full, Ray{{0, 1, 0}, normalize(Vec3(0.3f, 1, 0))}, rng).radiance;
+  Vec3 below = traceToGatherPoint(view, backend.intersector(), full, Ray{{3, 1, 0}, normalize(Vec3(0, -1, 0))}, rng).radiance;
+  EXPECT_EQ(up, sky.radiance);
+  EXPECT_EQ(below, Vec3(0.0f));
+  PhotonTraceParams tp;
+  tp.photonCount = 1u << 21;
+  tp.storeDirect = true;
+  tp.maxDepth = 1;
+  HashGrid grid = HashGrid::build(backend.tracePhotons(tp), 0.1f);
+  DensityParams dp;
+  dp.radius = 0.1f;
+  for (Vec3 p : {Vec3(0, 0, 0), Vec3(0.5f, 0, -0.4f)}) {
+    Vec3 e = estimateFluxDensity(grid.view(), p, {0, 1, 0}, dp);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(e[c], kPi * sky.radiance[c], 0.05f * kPi * sky.radiance[c]) << p.x;
+  }
+  Vec3 sum{0, 0, 0};
+  for (uint32_t i = 0; i < 100000; ++i) sum += emitPhoton(view, PhotonTraceParams{100000}, i).power;
+  Vec3 total = scene.totalLightPower();
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], total[c], 1e-3f * total[c]);
+}
+
 TEST(Lights, PhotonsCarryTheLightsPower) {
   Scene scene;
   uint32_t id = scene.addMaterial(Material{}, "floor");

@@ -419,9 +419,10 @@ int runCli(int argc, char** argv) {
   CLI::App* render = app.add_subcommand("render", "Render a stereo pair of a scene to PNG (sRGB) and EXR (linear)");
   render->footer(
       "Scenes: a built-in name (cornell, cornell-caustics, cornell-dense), a JSON scene file (docs/scene-format.md), or a mesh file\n"
-      "(.gltf, .glb, .obj+.mtl, .3ds via assimp). Materials: base colour (x its texture) -> diffuse, emissive -> area\n"
-      "light, metallic + smooth -> mirror, transmission / ior -> glass, alpha MASK / map_d -> cut-outs; point, spot\n"
-      "and directional lights (KHR_lights_punctual), normal and bump maps. Rough metals are not supported yet.\n"
+      "(.gltf, .glb, .obj+.mtl, .3ds via assimp). Materials: glTF metallic-roughness (GGX metals, glossy and rough\n"
+      "dielectrics, transmission / ior, base colour, metallic-roughness, normal, emissive and occlusion textures),\n"
+      "OBJ/MTL Kd, Ks/Ns (glossy), mirrors (illum 3) and glass (illum 4-9), alpha MASK / map_d cut-outs, bump maps;\n"
+      "point, spot and directional lights (KHR_lights_punctual) and a sky (JSON scenes).\n"
       "Defaults render the Cornell box at 1440x1600 per eye with 256x256 photons in a few seconds on 2 cores.");
   render->add_option("scene", ra.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
   addRenderOptions(*render, ra);

@@ -99,6 +99,20 @@ PVR_HOST_DEVICE Vec3 areaDirectLight(const SceneView& scene, const Intersector& 
   return bsdf(wi) * ls.emission * (cosSurface * cosLight / (dist2 * ls.pdfArea));
 }
 
+// One cosine-weighted sample of the sky's direct light at a surface point (front side only):
+// f L pi where the shadow ray escapes upwards.
+template <class Intersector, class Bsdf>
+PVR_HOST_DEVICE Vec3 skyDirectLight(const SceneView& scene, const Intersector& intersector, Vec3 position, Vec3 nGeo,
+                                    Vec3 nShade, float eps, CounterRng& rng, const Bsdf& bsdf) {
+  // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+  float u1 = rng.uniform();
+  float u2 = rng.uniform();
+  Vec3 wi = Frame::fromNormal(nShade).toWorld(sampleCosineHemisphere(u1, u2));
+  if (!(wi.y > 0.0f) || !(dot(nGeo, wi) > 0.0f)) return {0, 0, 0};
+  if (intersector.occluded(Ray{position + nGeo * eps, wi}, INFINITY)) return {0, 0, 0};
+  return bsdf(wi) * scene.sky.radiance * kPi;
+}
+
 // Follows the eye ray through mirrors and glass to a surface that gathers from the photon map.
 // `firstHit`, if given, is the ray's first intersection, already traced. `coneSpread` is the ray
 // cone's width per unit distance (a pixel's, for camera rays): it chooses the textures' level of
@@ -122,7 +136,10 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
     Hit hit;
     if (depth == 0 && firstHit) hit = *firstHit;
     else intersector.intersect(ray, INFINITY, hit);
-    if (!hit.valid()) break;
+    if (!hit.valid()) {  // escaped: the sky (never reached this way from a gather point)
+      out.radiance += throughput * scene.sky.along(ray.dir);
+      break;
+    }
     coneWidth += coneSpread * hit.t;
     SurfacePoint sp = scene.surfacePoint(hit);
     const Material& m = scene.materials[sp.materialId];
@@ -138,6 +155,8 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
         out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, nShade, false, eps, lambertian);
         if (scene.triangleLightCount > 0)
           out.radiance += throughput * areaDirectLight(scene, intersector, sp.position, nGeo, nShade, eps, rng, lambertian);
+        if (scene.sky.present())
+          out.radiance += throughput * skyDirectLight(scene, intersector, sp.position, nGeo, nShade, eps, rng, lambertian);
       }
       out.weight = throughput * brdf;
       if (m.occlusionTexture.present()) out.weight *= scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
@@ -160,9 +179,11 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
       if (!follow) {
         const uint32_t gathered = kLobesAll & ~followed;
         const Vec3 scale = throughput * (1.0f / (1.0f - pFollow));
+        auto gatheredBsdf = [&](Vec3 wi) { return b.eval(wo, wi, gathered); };
         if (full && scene.triangleLightCount > 0)
-          out.radiance += scale * areaDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng,
-                                                  [&](Vec3 wi) { return b.eval(wo, wi, gathered); });
+          out.radiance += scale * areaDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
+        if (full && scene.sky.present())
+          out.radiance += scale * skyDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
         out.weight = scale;
         if (m.occlusionTexture.present()) out.weight *= scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
         out.position = sp.position;

@@ -6,7 +6,9 @@
 // cosine-weighted direction; the photon carries Le * pi * area / (pdf_pick * N), which is exactly
 // Phi / N when all lights share one colour. A point light: a uniform direction, 4 pi I / (pick N);
 // a spot: uniform within the outer cone, weighted by its falloff; a distant light: a uniform point
-// on a disk as wide as the scene's bounding sphere, upstream of it, carrying E pi R^2 / (pick N). At a diffuse surface the photon is stored, then
+// on a disk as wide as the scene's bounding sphere, upstream of it, carrying E pi R^2 / (pick N);
+// the sky: a uniform direction of the upper hemisphere through such a disk, L 2 pi^2 R^2 / (pick N).
+// At a diffuse surface the photon is stored, then
 // continues with Russian roulette (probability = max albedo component, power scaled so the
 // expectation is unchanged). A microfacet surface stores the photon too, then samples its whole
 // BSDF (shading/bsdf.h), with Russian roulette on the sample's weight. Mirrors reflect and glass
@@ -34,6 +36,22 @@ PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTra
   float uTheta = rng.uniform();
   float uPhi = rng.uniform();
   Photon p;
+  if (ls.sky) {  // a uniform direction from the upper hemisphere through a disk facing it
+    const float n = float(params.photonCount) * ls.pick;
+    Vec3 toSky = Frame::fromNormal({0, 1, 0}).toWorld(
+        {sqrtf(fmaxf(0.0f, 1.0f - uTheta * uTheta)) * cosf(2.0f * kPi * uPhi),
+         sqrtf(fmaxf(0.0f, 1.0f - uTheta * uTheta)) * sinf(2.0f * kPi * uPhi), uTheta});
+    const SkyLight& sky = scene.sky;
+    const float radius = sky.photonRadius(scene.sceneRadius);
+    const Vec3 center = sky.aimRadius > 0.0f ? sky.aimCenter : scene.sceneCenter;
+    Frame frame = Frame::fromNormal(toSky);
+    float r = radius * sqrtf(u1), phi = 2.0f * kPi * u2;
+    float back = length(center - scene.sceneCenter) + 2.0f * scene.sceneRadius;
+    p.position = center + toSky * back + frame.toWorld({r * cosf(phi), r * sinf(phi), 0.0f});
+    p.direction = -toSky;
+    p.power = sky.radiance * (2.0f * kPi * kPi * radius * radius / n);
+    return p;
+  }
   if (ls.punctual >= 0) {
     const PunctualLight& l = scene.punctualLights[ls.punctual];
     const float n = float(params.photonCount) * ls.pick;

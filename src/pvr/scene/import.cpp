@@ -7,7 +7,8 @@
 //             alphaCutoff -> alpha-tested cut-outs.
 //   OBJ/MTL:  Kd (x map_Kd) -> albedo; Ke -> Le; illum 3 or 5 -> mirror (reflectance Ks, else Kd);
 //             illum 4, 6, 7 or 9, or d < 0.5 without map_d -> glass (ior Ni); map_d -> cut-out;
-//             Ks (x map_Ks) with illum 2 (or none) -> a glossy dielectric layer of F0 = max(Ks)
+//             Ks (x map_Ks) with illum 2 (or none) -> a glossy dielectric layer of F0 = 0.08 max(Ks)
+//             (Ks read as Blender's "specular": 0.5 is a plastic's 0.04)
 //             and roughness from Ns (x map_Ns), alpha = sqrt(2 / (Ns + 2)) (Blinn-Phong's match).
 //   3DS:      diffuse colour (x its texture map) -> albedo; specular colour and shininess as
 //             OBJ's Ks and Ns.
@@ -111,7 +112,7 @@ void glossyLayerFromPhong(const aiScene& as, const aiMaterial& am, int illum, co
   if (illum == 0 || illum == 1 || !std::isfinite(f0) || !(f0 > 0.0f)) return;  // no highlights
   if (!std::isfinite(shininess) || shininess < 0.0f) shininess = 0.0f;
   m.type = MaterialType::Microfacet;
-  m.specularF0 = std::min(f0, 1.0f);
+  m.specularF0 = 0.08f * std::min(f0, 1.0f);  // Ks as Blender's "specular" (0.5: F0 = 0.04, plastic)
   m.roughness = std::sqrt(std::sqrt(2.0f / (shininess + 2.0f)));  // alpha = roughness^2
   m.specularTexture = textureOf(as, am, aiTextureType_SPECULAR, false, folder, textures);
   m.shininessTexture = textureOf(as, am, aiTextureType_SHININESS, false, folder, textures);

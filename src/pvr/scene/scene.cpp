@@ -70,7 +70,7 @@ void Scene::finalize() {
     faceNormals_[t] = normalize(cross(b - a, c - a));
   }
   for (size_t i = 0; i < materials_.size(); ++i)
-    for (const TextureRef* ref : {&materials_[i].baseColorTexture, &materials_[i].opacityTexture, &materials_[i].normalTexture})
+    for (const TextureRef* ref : materials_[i].textureRefs())
       if (ref->texture >= int32_t(textures_.size()))
         throw Error("material '" + materialNames_[i] + "' refers to a missing texture");
   lightTriangles_.clear();
@@ -92,8 +92,9 @@ void Scene::finalize() {
     float w = luminance(punctualPower(l, sceneRadius_)) / kPi;
     lightCdf_.push_back(lightCdf_.back() + (w > 0.0f ? w : 0.0f));
   }
+  if (sky_.present()) lightCdf_.push_back(lightCdf_.back() + luminance(sky_.power(sceneRadius_)) / kPi);
   if (!(lightCdf_.back() > 0.0f))
-    throw Error("scene '" + name + "' has no light (no emissive triangle, no point, spot or sun light)");
+    throw Error("scene '" + name + "' has no light (no emissive triangle, no point, spot or sun light, no sky)");
 }
 
 uint32_t Scene::addTexture(const std::string& textureName, int width, int height, std::vector<uint32_t> rgba, bool srgb,
@@ -144,6 +145,14 @@ uint32_t Scene::addTexture(const std::string& textureName, int width, int height
   return uint32_t(textures_.size() - 1);
 }
 
+void Scene::setSky(const SkyLight& sky) {
+  if (!isFinite(sky.radiance) || !isFinite(sky.aimCenter) || !std::isfinite(sky.aimRadius))
+    throw Error("the sky has a non-finite radiance or aim");
+  if (sky.radiance.x < 0 || sky.radiance.y < 0 || sky.radiance.z < 0) throw Error("the sky's radiance must not be negative");
+  if (sky.aimRadius < 0) throw Error("the sky's aim_radius must be positive");
+  sky_ = sky;
+}
+
 uint32_t Scene::addPunctualLight(const PunctualLight& light, const std::string& lightName) {
   PunctualLight l = light;
   const std::string what = "light '" + lightName + "'";
@@ -179,6 +188,7 @@ Scene& Scene::operator=(const Scene& other) {
   meshes_ = other.meshes_;
   lightTriangles_ = other.lightTriangles_;
   punctualLights_ = other.punctualLights_;
+  sky_ = other.sky_;
   lightCdf_ = other.lightCdf_;
   skippedTriangles_ = other.skippedTriangles_;
   sceneRadius_ = other.sceneRadius_;
@@ -216,7 +226,10 @@ SceneView Scene::view() const {
   v.triangleLightCount = uint32_t(lightTriangles_.size());
   v.punctualLights = punctualLights_.empty() ? nullptr : punctualLights_.data();
   v.punctualCount = uint32_t(punctualLights_.size());
-  v.lightCount = v.triangleLightCount + (lightCdf_.size() > lightTriangles_.size() + 1 ? v.punctualCount : 0);
+  // Before finalize() the CDF holds the triangles only.
+  const bool finalized = lightCdf_.size() == lightTriangles_.size() + 1 + punctualLights_.size() + (sky_.present() ? 1 : 0);
+  v.lightCount = v.triangleLightCount + (finalized ? v.punctualCount + (sky_.present() ? 1 : 0) : 0);
+  v.sky = sky_;
   v.sceneRadius = sceneRadius_;
   v.sceneCenter = sceneCenter_;
   return v;
@@ -239,6 +252,7 @@ Vec3 Scene::totalLightPower() const {
   Vec3 power{0, 0, 0};
   for (uint32_t t : lightTriangles_) power += materials_[materialIds_[t]].emission * (kPi * v.triangleArea(t));
   for (const PunctualLight& l : punctualLights_) power += punctualPower(l, sceneRadius_);
+  if (sky_.present()) power += sky_.power(sceneRadius_);
   return power;
 }
 

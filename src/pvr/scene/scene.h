@@ -50,6 +50,9 @@ class Scene {
   // negative values, a zero direction, or cones outside (0, 90] degrees with inner <= outer.
   uint32_t addPunctualLight(const PunctualLight& light, const std::string& name);
   const std::vector<PunctualLight>& punctualLights() const { return punctualLights_; }
+  // A uniform sky over the upper hemisphere. Throws pvr::Error for negative or non-finite values.
+  void setSky(const SkyLight& sky);
+  const SkyLight& sky() const { return sky_; }
   // Builds the light list; throws pvr::Error if nothing emits light or the scene is empty.
   void finalize();
 
@@ -87,6 +90,7 @@ class Scene {
   std::vector<MeshRange> meshes_;
   std::vector<uint32_t> lightTriangles_;
   std::vector<PunctualLight> punctualLights_;
+  SkyLight sky_;
   std::vector<float> lightCdf_;
   uint64_t skippedTriangles_ = 0;
   float sceneRadius_ = 1.0f;

@@ -184,9 +184,24 @@ Scene loadJsonScene(const std::string& path) {
           scene.addPunctualLight(p, l.contains("point") ? "point" : l.contains("spot") ? "spot" : "sun");
           continue;
         }
+        if (l.contains("sky")) {
+          checkKeys(l, "a sky", {"sky", "aim_center", "aim_radius"});
+          SkyLight sky;
+          sky.radiance = vec3(l["sky"], "light sky");
+          if (l.contains("aim_center") != l.contains("aim_radius"))
+            throw Error("a sky's aim needs both aim_center and aim_radius");
+          if (l.contains("aim_center")) {
+            sky.aimCenter = vec3(l["aim_center"], "sky aim_center");
+            sky.aimRadius = number(l["aim_radius"], "sky aim_radius");
+            if (!(sky.aimRadius > 0.0f)) throw Error("sky aim_radius must be positive");
+          }
+          if (scene.sky().present()) throw Error("a scene has at most one sky");
+          scene.setSky(sky);
+          continue;
+        }
         checkKeys(l, "a light", {"quad", "emission"});
         if (!l.contains("quad") || !l["quad"].is_array() || l["quad"].size() != 4)
-          throw Error("a light needs \"quad\" (four corners), \"point\", \"spot\" or \"sun\"");
+          throw Error("a light needs \"quad\" (four corners), \"point\", \"spot\", \"sun\" or \"sky\"");
         Material m;
         m.emission = vec3(l.value("emission", json::array({10, 10, 10})), "light emission");
         if (m.emission.x < 0 || m.emission.y < 0 || m.emission.z < 0) throw Error("light emission must not be negative");

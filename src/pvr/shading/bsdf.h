@@ -65,6 +65,7 @@ struct BsdfParams {
     float fo = specularF0 + (f90 - specularF0) * schlickWeight(cosO);
     float fi = specularF0 + (f90 - specularF0) * schlickWeight(cosI);
     float average = specularF0 + (f90 - specularF0) * (1.0f / 21.0f);
+    if (!(average < 1.0f)) return 0.0f;  // a layer that reflects everything leaves nothing below
     return (1.0f - fo) * (1.0f - fi) / (1.0f - average);
   }
 

@@ -4,6 +4,8 @@
 // glass). Photons are stored on every surface that is not a mirror or smooth glass. Any material
 // may also emit (an area light). Factors may be multiplied by textures, and an alpha mask may cut
 // texels out of the surface.
+#include <array>
+
 #include "pvr/math/vec.h"
 #include "pvr/shading/texture.h"
 
@@ -39,6 +41,12 @@ struct Material {
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alpha = 1.0f;             ///< baseColorFactor's alpha
   float alphaCutoff = 0.5f;       ///< MASK: texels with alpha below this are cut out
+
+  // Every texture reference, for validation.
+  std::array<const TextureRef*, 8> textureRefs() const {
+    return {&baseColorTexture, &opacityTexture, &normalTexture, &metallicRoughnessTexture, &emissiveTexture,
+            &occlusionTexture, &specularTexture, &shininessTexture};
+  }
 
   PVR_HOST_DEVICE bool alphaTested() const { return alphaMode != AlphaMode::Opaque; }
 

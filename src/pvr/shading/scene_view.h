@@ -32,6 +32,23 @@ struct PunctualLight {
   }
 };
 
+// A uniform sky: radiance L from every direction above the horizon (+y up), none below. Its photons
+// cross a disk of aimRadius around aimCenter (an opening such as a courtyard's roof), or the
+// scene's bounding sphere when aimRadius is 0.
+struct SkyLight {
+  Vec3 radiance{0, 0, 0};
+  Vec3 aimCenter{0, 0, 0};
+  float aimRadius = 0.0f;
+  PVR_HOST_DEVICE bool present() const { return !isBlack(radiance); }
+  PVR_HOST_DEVICE Vec3 along(Vec3 dir) const { return dir.y > 0.0f ? radiance : Vec3{0, 0, 0}; }
+  PVR_HOST_DEVICE float photonRadius(float sceneRadius) const { return aimRadius > 0.0f ? aimRadius : sceneRadius; }
+  // The flux that enters a sphere of radius R from the upper hemisphere: L pi R^2 2 pi.
+  PVR_HOST_DEVICE Vec3 power(float sceneRadius) const {
+    float r = photonRadius(sceneRadius);
+    return radiance * (2.0f * kPi * kPi * r * r);
+  }
+};
+
 // Local geometry at a hit.
 struct SurfacePoint {
   Vec3 position;
@@ -55,10 +72,11 @@ struct SceneView {
   // lightCount + 1 entries over the emitting triangles, then the punctual lights, weighted by
   // power / pi: luminance(Le) * area for a triangle, 4 I for a point light, ...
   const float* lightCdf = nullptr;
-  uint32_t lightCount = 0;           ///< triangleLightCount + punctualCount
+  uint32_t lightCount = 0;           ///< triangleLightCount + punctualCount (+ 1 with a sky)
   uint32_t triangleLightCount = 0;
   const PunctualLight* punctualLights = nullptr;
   uint32_t punctualCount = 0;
+  SkyLight sky;             ///< last in lightCdf when present
   float sceneRadius = 1.0f;  ///< scales ray offsets; the bounding sphere's radius
   Vec3 sceneCenter{0, 0, 0};
 
@@ -253,6 +271,7 @@ struct LightSample {
   float pdfArea;  ///< area: probability density per unit area over all light surfaces
   float pick = 1.0f;  ///< probability of choosing this light
   int punctual = -1;  ///< index into punctualLights, or -1 for an area light
+  bool sky = false;   ///< the sky was chosen
 };
 
 PVR_HOST_DEVICE inline LightSample sampleLight(const SceneView& s, float uPick, float u1, float u2) {
@@ -260,6 +279,12 @@ PVR_HOST_DEVICE inline LightSample sampleLight(const SceneView& s, float uPick, 
   float pick = (s.lightCdf[i + 1] - s.lightCdf[i]) / s.lightCdf[s.lightCount];
   LightSample ls;
   ls.pick = pick;
+  if (uint32_t(i) >= s.triangleLightCount + s.punctualCount) {
+    ls.sky = true;
+    ls.emission = s.sky.radiance;
+    ls.pdfArea = 0.0f;
+    return ls;
+  }
   if (uint32_t(i) >= s.triangleLightCount) {
     ls.punctual = i - int(s.triangleLightCount);
     const PunctualLight& l = s.punctualLights[ls.punctual];
