@@ -6,13 +6,13 @@ namespace {
 
 // Hybrid, second kernel: one estimate per gather point, in the same 8x8 tiles.
 template <class Map, Estimator E>
-__global__ void densityKernel(Map map, DensityParams density, const GatherPoint* points, int width, int height,
+__global__ void densityKernel(Map map, DensityParams density, GatherPointStore points, int width, int height,
                               int sample, int samples, Vec3* image) {
   int x, y;
   if (!tilePixel(width, height, x, y)) return;
   density.estimator = E;
   size_t pixel = size_t(y) * width + x;
-  storeSample(image, pixel, finishGather(map, points[pixel], density), sample, samples);
+  storeSample(image, pixel, finishGather(map, points.load(pixel), density), sample, samples);
 }
 
 // The paper's Algorithm 1. The threads of an 8x8 block find their gather points' cells; if all
@@ -21,7 +21,7 @@ __global__ void densityKernel(Map map, DensityParams density, const GatherPoint*
 // tests all staged photons against its own point. Otherwise each thread estimates alone.
 template <Estimator E>
 __global__ void __launch_bounds__(kTile* kTile) sharedDensityKernel(HashGridView map, DensityParams density,
-                                                                    const GatherPoint* points, int width, int height,
+                                                                    GatherPointStore points, int width, int height,
                                                                     int sample, int samples, Vec3* image) {
   constexpr int kThreads = kTile * kTile;
   __shared__ Photon staged[kThreads];
@@ -31,7 +31,7 @@ __global__ void __launch_bounds__(kTile* kTile) sharedDensityKernel(HashGridView
   bool inside = tilePixel(width, height, x, y);
   size_t pixel = size_t(y) * width + x;
   GatherPoint gp;
-  if (inside) gp = points[pixel];
+  if (inside) gp = points.load(pixel);
   int64_t cell = inside && gp.needsEstimate() ? map.cellOf(gp.position) : -1;
   bool estimating = cell >= 0;  // a point outside the grid has no photons in reach
   if (tid == 0) cellMin = INT_MAX, cellMax = -1;
@@ -80,24 +80,24 @@ __global__ void __launch_bounds__(kTile* kTile) sharedDensityKernel(HashGridView
 }
 
 // Our improvement: gather points sorted by cell, so consecutive threads share their cell.
-__global__ void cellKeysOfPointsKernel(HashGridView map, const GatherPoint* points, uint32_t n, uint32_t noCell,
+__global__ void cellKeysOfPointsKernel(HashGridView map, GatherPointStore points, uint32_t n, uint32_t noCell,
                                        uint32_t* keys, uint32_t* values) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  GatherPoint gp = points[i];
+  GatherPoint gp = points.load(i);
   int64_t cell = gp.needsEstimate() ? map.cellOf(gp.position) : -1;
   keys[i] = cell < 0 ? noCell : uint32_t(cell);
   values[i] = i;
 }
 
 template <Estimator E>
-__global__ void sortedDensityKernel(HashGridView map, DensityParams density, const GatherPoint* points,
+__global__ void sortedDensityKernel(HashGridView map, DensityParams density, GatherPointStore points,
                                     const uint32_t* order, uint32_t n, int sample, int samples, Vec3* image) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   density.estimator = E;
   uint32_t pixel = order[i];
-  storeSample(image, pixel, finishGather(map, points[pixel], density), sample, samples);
+  storeSample(image, pixel, finishGather(map, points.load(pixel), density), sample, samples);
 }
 
 // Under stereo reuse the right eye is left with a sparse set of gather points (disocclusions,
@@ -105,14 +105,14 @@ __global__ void sortedDensityKernel(HashGridView map, DensityParams density, con
 // waiting on a few long chains of dependent loads; instead the points are listed (CUB select) and
 // each warp estimates one point, its lanes splitting every cell row's photons (radius estimate).
 
-__global__ void storeWithoutEstimateKernel(const GatherPoint* points, uint32_t n, int sample, int samples, Vec3* image) {
+__global__ void storeWithoutEstimateKernel(GatherPointStore points, uint32_t n, int sample, int samples, Vec3* image) {
   uint32_t pixel = blockIdx.x * blockDim.x + threadIdx.x;
   if (pixel >= n) return;
-  GatherPoint gp = points[pixel];
+  GatherPoint gp = points.load(pixel);
   if (!gp.needsEstimate()) storeSample(image, pixel, gp.radiance, sample, samples);
 }
 
-__global__ void warpPerPointDensityKernel(HashGridView map, float radius, const GatherPoint* points,
+__global__ void warpPerPointDensityKernel(HashGridView map, float radius, GatherPointStore points,
                                           const uint32_t* list, const uint32_t* listed, int sample, int samples,
                                           Vec3* image) {
   const unsigned lane = threadIdx.x & 31u;
@@ -121,7 +121,7 @@ __global__ void warpPerPointDensityKernel(HashGridView map, float radius, const 
   const uint32_t n = *listed;
   for (uint32_t i = (blockIdx.x * blockDim.x + threadIdx.x) >> 5; i < n; i += warps) {  // warp-uniform
     uint32_t pixel = list[i];
-    GatherPoint gp = points[pixel];
+    GatherPoint gp = points.load(pixel);
     Vec3 sum{0, 0, 0};
     // No estimate for a point without a diffuse surface, or one reused from the other eye.
     int64_t cell = map.photonCount && gp.needsEstimate() ? map.cellOf(gp.position) : -1;
@@ -144,17 +144,17 @@ __global__ void warpPerPointDensityKernel(HashGridView map, float radius, const 
 
 // One thread per listed gather point (kNN, or the kd-tree).
 template <class Map, Estimator E>
-__global__ void listedDensityKernel(Map map, DensityParams density, const GatherPoint* points, const uint32_t* list,
+__global__ void listedDensityKernel(Map map, DensityParams density, GatherPointStore points, const uint32_t* list,
                                     const uint32_t* listed, Vec3* colours) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= *listed) return;
   density.estimator = E;
   uint32_t vertex = list[i];
-  colours[vertex] = finishGather(map, points[vertex], density);
+  colours[vertex] = finishGather(map, points.load(vertex), density);
 }
 
 template <class Map>
-void estimateTiledWith(const Map& map, const DensityParams& density, const GatherPoint* points, int width, int height,
+void estimateTiledWith(const Map& map, const DensityParams& density, GatherPointStore points, int width, int height,
                        int sample, int samples, Vec3* image, cudaStream_t stream) {
   auto* kernel = density.estimator == Estimator::Knn ? densityKernel<Map, Estimator::Knn> : densityKernel<Map, Estimator::Radius>;
   launch("density estimation", kernel, tileGrid(width, height), dim3(kTile, kTile), 0, stream, map, density, points,
@@ -162,7 +162,7 @@ void estimateTiledWith(const Map& map, const DensityParams& density, const Gathe
 }
 
 template <class Map>
-void estimateListedWith(const Map& map, const DensityParams& density, const GatherPoint* points, const uint32_t* list,
+void estimateListedWith(const Map& map, const DensityParams& density, GatherPointStore points, const uint32_t* list,
                         const uint32_t* listed, uint32_t maxListed, Vec3* colours, cudaStream_t stream) {
   auto* kernel = density.estimator == Estimator::Knn ? listedDensityKernel<Map, Estimator::Knn>
                                                      : listedDensityKernel<Map, Estimator::Radius>;
@@ -172,45 +172,45 @@ void estimateListedWith(const Map& map, const DensityParams& density, const Gath
 
 }  // namespace
 
-void estimateTiled(DeviceMap map, const DensityParams& density, const GatherPoint* points, int width, int height,
+void estimateTiled(DeviceMap map, const DensityParams& density, GatherPointStore points, int width, int height,
                    int sample, int samples, Vec3* image, cudaStream_t stream) {
   if (map.grid) estimateTiledWith(*map.grid, density, points, width, height, sample, samples, image, stream);
   else estimateTiledWith(*map.tree, density, points, width, height, sample, samples, image, stream);
 }
 
-void estimateSharedMemory(const HashGridView& map, const DensityParams& density, const GatherPoint* points, int width,
+void estimateSharedMemory(const HashGridView& map, const DensityParams& density, GatherPointStore points, int width,
                           int height, int sample, int samples, Vec3* image, cudaStream_t stream) {
   auto* kernel = density.estimator == Estimator::Knn ? sharedDensityKernel<Estimator::Knn> : sharedDensityKernel<Estimator::Radius>;
   launch("density estimation (shared memory)", kernel, tileGrid(width, height), dim3(kTile, kTile), 0, stream, map,
          density, points, width, height, sample, samples, image);
 }
 
-void writeCellKeysOfPoints(const HashGridView& map, const GatherPoint* points, uint32_t n, uint32_t noCell,
+void writeCellKeysOfPoints(const HashGridView& map, GatherPointStore points, uint32_t n, uint32_t noCell,
                            uint32_t* keys, uint32_t* values, cudaStream_t stream) {
   launch("gather-point cell keys", cellKeysOfPointsKernel, blocksFor(n, 256), 256, 0, stream, map, points, n, noCell,
          keys, values);
 }
 
-void estimateInOrder(const HashGridView& map, const DensityParams& density, const GatherPoint* points,
+void estimateInOrder(const HashGridView& map, const DensityParams& density, GatherPointStore points,
                      const uint32_t* order, uint32_t n, int sample, int samples, Vec3* image, cudaStream_t stream) {
   auto* kernel = density.estimator == Estimator::Knn ? sortedDensityKernel<Estimator::Knn> : sortedDensityKernel<Estimator::Radius>;
   launch("density estimation (cell order)", kernel, blocksFor(n, 128), 128, 0, stream, map, density, points, order, n,
          sample, samples, image);
 }
 
-void storeWithoutEstimate(const GatherPoint* points, uint32_t n, int sample, int samples, Vec3* image,
+void storeWithoutEstimate(GatherPointStore points, uint32_t n, int sample, int samples, Vec3* image,
                           cudaStream_t stream) {
   launch("store without estimate", storeWithoutEstimateKernel, blocksFor(n, 256), 256, 0, stream, points, n, sample,
          samples, image);
 }
 
-void estimateWarpPerPoint(const HashGridView& map, float radius, const GatherPoint* points, const uint32_t* list,
+void estimateWarpPerPoint(const HashGridView& map, float radius, GatherPointStore points, const uint32_t* list,
                           const uint32_t* listed, int sample, int samples, Vec3* image, cudaStream_t stream) {
   launch("density estimation (warp per point)", warpPerPointDensityKernel, unsigned(multiprocessorCount()) * 8u, 256, 0,
          stream, map, radius, points, list, listed, sample, samples, image);
 }
 
-void estimateListed(DeviceMap map, const DensityParams& density, const GatherPoint* points, const uint32_t* list,
+void estimateListed(DeviceMap map, const DensityParams& density, GatherPointStore points, const uint32_t* list,
                     const uint32_t* listed, uint32_t maxListed, Vec3* colours, cudaStream_t stream) {
   if (map.grid) estimateListedWith(*map.grid, density, points, list, listed, maxListed, colours, stream);
   else estimateListedWith(*map.tree, density, points, list, listed, maxListed, colours, stream);

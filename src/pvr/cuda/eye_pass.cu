@@ -25,14 +25,14 @@ __global__ void singleKernel(SceneView scene, BvhIntersector intersector, Map ma
 // Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
 template <StereoRole R>
 __global__ void eyeRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
-                              Eye eye, int sample, StereoReuseView reuse, GatherPoint* points, EyeOutputs out) {
+                              Eye eye, int sample, StereoReuseView reuse, GatherPointStore points, EyeOutputs out) {
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   size_t pixel = size_t(y) * camera.width + x;
   PixelSample state;
   if (R == StereoRole::Reuser && sample > 0) state.reusedFrom = out.reusedFrom[pixel];  // sample 0 decided
-  points[pixel] = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuseFor<R>(reuse), state,
-                                   surfaceFor<R>(out, pixel));
+  points.store(pixel, pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuseFor<R>(reuse), state,
+                                   surfaceFor<R>(out, pixel)));
   if (sample == 0) recordPixel(out, pixel, state);
 }
 
@@ -138,7 +138,7 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
     estimateCount_.reserve(1, "gather points to estimate");
     size_t bytes = 0;
     PVR_CUDA_CHECK(cub::DeviceSelect::If(nullptr, bytes, thrust::counting_iterator<uint32_t>(0), estimateList_.data(),
-                                         estimateCount_.data(), int(pixels), NeedsEstimate{points_.data()}, stream));
+                                         estimateCount_.data(), int(pixels), NeedsEstimate{points_.view()}, stream));
     temp_.reserve(bytes, "gather-point selection scratch");
   }
   auto* eyeRays = pass.role == StereoRole::Reuser   ? eyeRaysKernel<StereoRole::Reuser>
@@ -149,29 +149,29 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
     {
       StageScope scope(clock, Stage::EyeRays, e);
       launch("eye rays", eyeRays, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream, scene.view,
-             scene.intersector, params, camera, eye, s, reuse, points_.data(), out);
+             scene.intersector, params, camera, eye, s, reuse, points_.view(), out);
     }
     StageScope scope(clock, Stage::Density, e);
     if (sparse) {
       size_t bytes = temp_.capacity();
       PVR_CUDA_CHECK(cub::DeviceSelect::If(temp_.data(), bytes, thrust::counting_iterator<uint32_t>(0),
                                            estimateList_.data(), estimateCount_.data(), int(pixels),
-                                           NeedsEstimate{points_.data()}, stream));
-      storeWithoutEstimate(points_.data(), uint32_t(pixels), s, samples, image, stream);
-      estimateWarpPerPoint(*map.grid, params.density.radius, points_.data(), estimateList_.data(), estimateCount_.data(),
+                                           NeedsEstimate{points_.view()}, stream));
+      storeWithoutEstimate(points_.view(), uint32_t(pixels), s, samples, image, stream);
+      estimateWarpPerPoint(*map.grid, params.density.radius, points_.view(), estimateList_.data(), estimateCount_.data(),
                            s, samples, image, stream);
     } else if (pass.kernel == DensityKernel::Hybrid) {
-      estimateTiled(map, params.density, points_.data(), camera.width, camera.height, s, samples, image, stream);
+      estimateTiled(map, params.density, points_.view(), camera.width, camera.height, s, samples, image, stream);
     } else if (pass.kernel == DensityKernel::SharedMemory) {
-      estimateSharedMemory(*map.grid, params.density, points_.data(), camera.width, camera.height, s, samples, image,
+      estimateSharedMemory(*map.grid, params.density, points_.view(), camera.width, camera.height, s, samples, image,
                            stream);
     } else {
-      writeCellKeysOfPoints(*map.grid, points_.data(), uint32_t(pixels), noCell, sortKeys_[0].data(),
+      writeCellKeysOfPoints(*map.grid, points_.view(), uint32_t(pixels), noCell, sortKeys_[0].data(),
                             sortValues_[0].data(), stream);
       cub::DoubleBuffer<uint32_t> k(sortKeys_[0].data(), sortKeys_[1].data()), v(sortValues_[0].data(), sortValues_[1].data());
       size_t bytes = temp_.capacity();
       PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, k, v, int(pixels), 0, endBit, stream));
-      estimateInOrder(*map.grid, params.density, points_.data(), v.Current(), uint32_t(pixels), s, samples, image, stream);
+      estimateInOrder(*map.grid, params.density, points_.view(), v.Current(), uint32_t(pixels), s, samples, image, stream);
     }
   }
 }

@@ -33,7 +33,7 @@ struct VertexInUse {
 template <StereoRole R>
 __global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
                                  Eye eye, DeviceMaskView mask, int gazeX, int gazeY, const uint32_t* list,
-                                 const uint32_t* listed, StereoReuseView reuse, EyeOutputs out, GatherPoint* points,
+                                 const uint32_t* listed, StereoReuseView reuse, EyeOutputs out, GatherPointStore points,
                                  float* inverseDepths) {
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= *listed) return;
@@ -42,12 +42,12 @@ __global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, Ga
   const float px = o.x + float(gazeX) + 0.5f, py = o.y + float(gazeY) + 0.5f;
   if constexpr (R == StereoRole::Alone) {
     float inverseDepth;  // a local: storing to global memory mid-path costs registers
-    points[vertex] = imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, inverseDepth);
+    points.store(vertex, imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, inverseDepth));
     inverseDepths[vertex] = inverseDepth;
   } else {
     PixelSample sample;
-    points[vertex] = vertexGatherPoint(scene, intersector, params, camera, eye, px, py, reuseFor<R>(reuse), sample,
-                                       R == StereoRole::Source ? out.surfaces : nullptr);
+    points.store(vertex, vertexGatherPoint(scene, intersector, params, camera, eye, px, py, reuseFor<R>(reuse), sample,
+                                       R == StereoRole::Source ? out.surfaces : nullptr));
     inverseDepths[vertex] = sample.inverseDepth;
     if constexpr (R == StereoRole::Reuser) countInWarp(out.reusedCount, sample.reusedFrom != kNotReused);
   }
@@ -112,17 +112,17 @@ void GpuEyePass::renderFoveated(const DeviceScene& scene, DeviceMap map, const E
                                                          : vertexRaysKernel<StereoRole::Alone>;
     launch("eye rays (mask vertices)", vertexRays, blocksFor(mask.vertexCount, 128), 128, 0, stream, scene.view,
            scene.intersector, params, camera, eye, mask, gazeX, gazeY, vertexList_.data(), count, reuse, out,
-           vertexPoints_.data(), vertexInverseDepths_.data());
+           vertexPoints_.view(), vertexInverseDepths_.data());
   }
   {
     StageScope scope(clock, Stage::Density, e);
     // One warp per vertex, also for Geisler-Perry's ~300k: one thread per vertex was measured
     // slower there on the H100 (6.0 against 4.5 ms for both eyes' pass).
     if (map.grid && !knn)
-      estimateWarpPerPoint(*map.grid, params.density.radius, vertexPoints_.data(), vertexList_.data(), count, 0, 1,
+      estimateWarpPerPoint(*map.grid, params.density.radius, vertexPoints_.view(), vertexList_.data(), count, 0, 1,
                            vertexColours_.data(), stream);
     else
-      estimateListed(map, params.density, vertexPoints_.data(), vertexList_.data(), count, mask.vertexCount,
+      estimateListed(map, params.density, vertexPoints_.view(), vertexList_.data(), count, mask.vertexCount,
                      vertexColours_.data(), stream);
   }
 
