@@ -326,6 +326,8 @@ TEST(Lights, PhotonsCarryTheLightsPower) {
 #include <fstream>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "pvr/image/image_io.h"
 
 namespace pvr {
@@ -403,6 +405,62 @@ TEST(SceneImport, GltfTextureTransformIsRead) {
   EXPECT_FLOAT_EQ(all.rotation, 0.3f);
   EXPECT_FLOAT_EQ(all.scale.y, 1.5f);
   EXPECT_FLOAT_EQ(material("Correct").baseColorTexture.scale.x, 1.0f);  // no extension: identity
+}
+
+// The transform applies to every texture slot: the same file with "Offset U"'s texture also used
+// as its normal, emissive and occlusion maps (written beside the original's images).
+TEST(SceneImport, GltfTextureTransformAppliesToEverySlot) {
+  namespace fs = std::filesystem;
+  const fs::path source = "/usr/share/assimp/models/glTF2/textureTransform";
+  if (!fs::exists(source / "TextureTransformTest.gltf")) GTEST_SKIP() << "assimp-testmodels is not installed";
+  const fs::path dir = fs::temp_directory_path() / ("pvr_transform_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  for (const auto& entry : fs::directory_iterator(source))
+    if (entry.path().extension() != ".gltf") fs::copy_file(entry.path(), dir / entry.path().filename(), fs::copy_options::overwrite_existing);
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(source / "TextureTransformTest.gltf"));
+  for (auto& m : doc["materials"])
+    if (m["name"] == "Offset U") {
+      const nlohmann::json info = m["pbrMetallicRoughness"]["baseColorTexture"];
+      m["normalTexture"] = info;
+      m["emissiveTexture"] = info;
+      m["occlusionTexture"] = info;
+      m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = info;
+    }
+  std::ofstream(dir / "slots.gltf") << doc.dump();
+  Scene scene;
+  importMeshFile((dir / "slots.gltf").string(), scene);
+  const auto& names = scene.materialNames();
+  const Material& m = scene.materials()[size_t(std::find(names.begin(), names.end(), "Offset U") - names.begin())];
+  EXPECT_EQ(m.type, MaterialType::Microfacet);
+  for (const TextureRef* ref : {&m.normalTexture, &m.emissiveTexture, &m.occlusionTexture, &m.metallicRoughnessTexture}) {
+    EXPECT_TRUE(ref->present());
+    EXPECT_FLOAT_EQ(ref->offset.x, 0.5f);
+  }
+  fs::remove_all(dir);
+}
+
+// Khronos' clear-coat test scene: its metallic-roughness and emissive textures load, its
+// materials are microfacet with their factors (the coat itself is not modelled).
+TEST(SceneImport, GltfMetallicRoughnessAndEmissiveTexturesLoad) {
+  const std::string path = "/usr/share/assimp/models/glTF2/ClearCoat-glTF/ClearCoatTest.gltf";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "assimp-testmodels is not installed";
+  Scene scene;
+  importMeshFile(path, scene);
+  auto material = [&](const std::string& name) -> const Material& {
+    const auto& names = scene.materialNames();
+    size_t i = size_t(std::find(names.begin(), names.end(), name) - names.begin());
+    EXPECT_LT(i, names.size()) << name;
+    return scene.materials()[std::min(i, names.size() - 1)];
+  };
+  const Material& base = material("Simple_Base");
+  EXPECT_EQ(base.type, MaterialType::Microfacet);
+  EXPECT_NEAR(base.roughness, 0.44f, 1e-6f);
+  EXPECT_EQ(base.metallic, 0.0f);
+  EXPECT_TRUE(material("RoughVariations_Coating").metallicRoughnessTexture.present());
+  const Material& label = material("LabelMaterial");
+  EXPECT_TRUE(label.emissiveTexture.present());
+  EXPECT_EQ(label.emission, Vec3(1.0f));
+  EXPECT_TRUE(material("BaseNorm_Base").normalTexture.present());
 }
 
 }  // namespace

@@ -189,15 +189,41 @@ Material convertMaterial(const aiScene& as, const aiMaterial& am, const std::str
 }
 
 // What assimp 5.2 drops of a glTF file's materials, read from its JSON: KHR_texture_transform on
-// the base colour texture and KHR_materials_emissive_strength. Empty for other formats, or when
-// the JSON cannot be read (assimp then reports the problem itself).
-struct GltfExtras {
-  bool hasTransform = false;
+// each texture (base colour, metallic-roughness, normal, emissive, occlusion) and
+// KHR_materials_emissive_strength. Empty for other formats, or when the JSON cannot be read
+// (assimp then reports the problem itself).
+struct TextureTransform {
+  bool present = false;
   TextureRef transform;  ///< offset, scale, rotation, and texCoord if the extension overrides it
   bool texCoordOverride = false;
+  void applyTo(TextureRef& ref) const {
+    if (!present || !ref.present()) return;
+    ref.offset = transform.offset;
+    ref.scale = transform.scale;
+    ref.rotation = transform.rotation;
+    if (texCoordOverride) ref.texCoord = transform.texCoord > 1 ? 0u : transform.texCoord;
+  }
+};
+enum GltfTextureSlot { kBaseColorSlot, kMetallicRoughnessSlot, kNormalSlot, kEmissiveSlot, kOcclusionSlot, kSlots };
+struct GltfExtras {
+  TextureTransform transforms[kSlots];
   float emissiveStrength = 1.0f;
   std::string name;
 };
+
+TextureTransform transformOf(const nlohmann::json& textureInfo) {
+  TextureTransform out;
+  if (!textureInfo.is_object() || !textureInfo.contains("extensions") ||
+      !textureInfo["extensions"].contains("KHR_texture_transform"))
+    return out;
+  const nlohmann::json& x = textureInfo["extensions"]["KHR_texture_transform"];
+  out.present = true;
+  if (x.contains("offset") && x["offset"].size() == 2) out.transform.offset = {x["offset"][0].get<float>(), x["offset"][1].get<float>()};
+  if (x.contains("scale") && x["scale"].size() == 2) out.transform.scale = {x["scale"][0].get<float>(), x["scale"][1].get<float>()};
+  if (x.contains("rotation")) out.transform.rotation = x["rotation"].get<float>();
+  if (x.contains("texCoord")) out.transform.texCoord = x["texCoord"].get<uint32_t>(), out.texCoordOverride = true;
+  return out;
+}
 
 std::vector<GltfExtras> readGltfExtras(const std::string& path) {
   using nlohmann::json;
@@ -233,17 +259,15 @@ std::vector<GltfExtras> readGltfExtras(const std::string& path) {
         strength = &m["extensions"]["KHR_materials_emissive_strength"];
       if (strength && strength->contains("emissiveStrength") && (*strength)["emissiveStrength"].is_number())
         e.emissiveStrength = (*strength)["emissiveStrength"].get<float>();
-      if (m.contains("pbrMetallicRoughness") && m["pbrMetallicRoughness"].contains("baseColorTexture")) {
-        const json& t = m["pbrMetallicRoughness"]["baseColorTexture"];
-        if (t.contains("extensions") && t["extensions"].contains("KHR_texture_transform")) {
-          const json& x = t["extensions"]["KHR_texture_transform"];
-          e.hasTransform = true;
-          if (x.contains("offset") && x["offset"].size() == 2) e.transform.offset = {x["offset"][0].get<float>(), x["offset"][1].get<float>()};
-          if (x.contains("scale") && x["scale"].size() == 2) e.transform.scale = {x["scale"][0].get<float>(), x["scale"][1].get<float>()};
-          if (x.contains("rotation")) e.transform.rotation = x["rotation"].get<float>();
-          if (x.contains("texCoord")) e.transform.texCoord = x["texCoord"].get<uint32_t>(), e.texCoordOverride = true;
-        }
+      if (m.contains("pbrMetallicRoughness") && m["pbrMetallicRoughness"].is_object()) {
+        const json& pbr = m["pbrMetallicRoughness"];
+        if (pbr.contains("baseColorTexture")) e.transforms[kBaseColorSlot] = transformOf(pbr["baseColorTexture"]);
+        if (pbr.contains("metallicRoughnessTexture"))
+          e.transforms[kMetallicRoughnessSlot] = transformOf(pbr["metallicRoughnessTexture"]);
       }
+      if (m.contains("normalTexture")) e.transforms[kNormalSlot] = transformOf(m["normalTexture"]);
+      if (m.contains("emissiveTexture")) e.transforms[kEmissiveSlot] = transformOf(m["emissiveTexture"]);
+      if (m.contains("occlusionTexture")) e.transforms[kOcclusionSlot] = transformOf(m["occlusionTexture"]);
       out.push_back(e);
     }
   } catch (const std::exception&) {
@@ -294,12 +318,11 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
     if (!found && !anyNamed && i < gltfExtras.size()) found = &gltfExtras[i];
     if (found) {
       const GltfExtras& e = *found;
-      if (e.hasTransform && m.baseColorTexture.present()) {
-        m.baseColorTexture.offset = e.transform.offset;
-        m.baseColorTexture.scale = e.transform.scale;
-        m.baseColorTexture.rotation = e.transform.rotation;
-        if (e.texCoordOverride) m.baseColorTexture.texCoord = e.transform.texCoord > 1 ? 0u : e.transform.texCoord;
-      }
+      e.transforms[kBaseColorSlot].applyTo(m.baseColorTexture);
+      e.transforms[kMetallicRoughnessSlot].applyTo(m.metallicRoughnessTexture);
+      e.transforms[kNormalSlot].applyTo(m.normalTexture);
+      e.transforms[kEmissiveSlot].applyTo(m.emissiveTexture);
+      e.transforms[kOcclusionSlot].applyTo(m.occlusionTexture);
       if (std::isfinite(e.emissiveStrength) && e.emissiveStrength >= 0.0f) m.emission *= e.emissiveStrength;
     }
     m.emission *= options.emissionScale;
