@@ -718,7 +718,8 @@ FrameRays countFrameRays(const Scene& scene, const StereoRig& rig, const RenderO
     for (size_t i = begin; i < end; ++i) tracePhoton(view, photonCounter, tp, uint32_t(i), buffer.data());
   });
   rays.photon = photonCounter.closest + photonCounter.shadow;
-  HashGrid grid = HashGrid::build(backend.tracePhotons(tp), o.gather.density.radius);
+  // Eye paths never depend on the photon map's contents: an empty one casts the same rays.
+  HashGrid grid = HashGrid::build({}, o.gather.density.radius);
   CountingIntersector eyeCounter{backend.intersector()};
   for (Eye eye : {Eye::Left, Eye::Right}) {
     const EyeCamera camera = rig.eye(eye);

@@ -374,27 +374,32 @@ Scene texturedLitCornell() {
   return scene;
 }
 
-TEST(GpuBackend, TexturesNormalMapsAlphaAndPunctualLightsMatchTheCpu) {
-  PVR_REQUIRE_GPU();
-  Scene scene = texturedLitCornell();
+// Renders `scene` (160x176 per eye) on the CPU and the GPU with options o in both shading modes,
+// once per GPU kernel in `kernels`: the same stored photons, and images within the parity bounds.
+void expectGpuMatchesCpuOnScene(const Scene& scene, RenderOptions o, std::initializer_list<DensityKernel> kernels,
+                                const std::string& label) {
   StereoRig rig = scene.rig;
   rig.width = 160, rig.height = 176;
   FrameRenderer cpu(makeCpuFrameRenderer(scene)), gpu(makeCudaFrameRenderer(scene));
   for (ShadingMode mode : {ShadingMode::Full, ShadingMode::PhotonMapOnly}) {
-    RenderOptions o = comparisonOptions();
     o.gather.mode = mode;
     FrameResult reference = cpu.render(rig, o);
-    for (DensityKernel kernel : {DensityKernel::Single, DensityKernel::Hybrid}) {
+    for (DensityKernel kernel : kernels) {
       o.kernel = kernel;
       FrameResult frame = gpu.render(rig, o);
       ImageCheck c = compare(reference, frame);
-      std::string what = std::string(densityKernelName(kernel)) + (mode == ShadingMode::Full ? " full" : " photons");
+      std::string what = std::string(densityKernelName(kernel)) + (mode == ShadingMode::Full ? " full" : " photons") + label;
       EXPECT_EQ(frame.storedPhotons, reference.storedPhotons) << what;
       EXPECT_LT(c.relativeMad, 0.01) << what;
       EXPECT_LT(c.outliers, 0.005) << what;
       EXPECT_GT(c.firstPrimAgree, 0.995) << what;
     }
   }
+}
+
+TEST(GpuBackend, TexturesNormalMapsAlphaAndPunctualLightsMatchTheCpu) {
+  PVR_REQUIRE_GPU();
+  expectGpuMatchesCpuOnScene(texturedLitCornell(), comparisonOptions(), {DensityKernel::Single, DensityKernel::Hybrid}, "");
 }
 
 // Microfacet materials on both sides of the gathered/followed split (rough gold, a sharp metal, a
@@ -450,28 +455,14 @@ Scene microfacetSkyCornell() {
 TEST(GpuBackend, MicrofacetMaterialsAndTheSkyMatchTheCpu) {
   PVR_REQUIRE_GPU();
   Scene scene = microfacetSkyCornell();
-  StereoRig rig = scene.rig;
-  rig.width = 160, rig.height = 176;
-  FrameRenderer cpu(makeCpuFrameRenderer(scene)), gpu(makeCudaFrameRenderer(scene));
-  for (ShadingMode mode : {ShadingMode::Full, ShadingMode::PhotonMapOnly})
-    for (StereoMode stereo : {StereoMode::Separate, StereoMode::Gather}) {
-      RenderOptions o = comparisonOptions();
-      o.gather.mode = mode;
-      o.stereo = stereo;
-      FrameResult reference = cpu.render(rig, o);
-      for (DensityKernel kernel :
-           {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory, DensityKernel::CellSorted}) {
-        o.kernel = kernel;
-        FrameResult frame = gpu.render(rig, o);
-        ImageCheck c = compare(reference, frame);
-        std::string what = std::string(densityKernelName(kernel)) + (mode == ShadingMode::Full ? " full " : " photons ") +
-                           stereoModeName(stereo);
-        EXPECT_EQ(frame.storedPhotons, reference.storedPhotons) << what;
-        EXPECT_LT(c.relativeMad, 0.01) << what;
-        EXPECT_LT(c.outliers, 0.005) << what;
-        EXPECT_GT(c.firstPrimAgree, 0.995) << what;
-      }
-    }
+  for (StereoMode stereo : {StereoMode::Separate, StereoMode::Gather}) {
+    RenderOptions o = comparisonOptions();
+    o.stereo = stereo;
+    expectGpuMatchesCpuOnScene(scene, o,
+                               {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory,
+                                DensityKernel::CellSorted},
+                               std::string(" ") + stereoModeName(stereo));
+  }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "pvr/photon/hash_grid.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "test_scenes.h"
 
 namespace pvr {
 namespace {
@@ -389,12 +390,7 @@ TEST(SceneImport, GltfTextureTransformIsRead) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "assimp-testmodels is not installed";
   Scene scene;
   importMeshFile(path, scene);
-  auto material = [&](const std::string& name) -> const Material& {
-    const auto& names = scene.materialNames();
-    size_t i = size_t(std::find(names.begin(), names.end(), name) - names.begin());
-    EXPECT_LT(i, names.size()) << name;
-    return scene.materials()[std::min(i, names.size() - 1)];
-  };
+  auto material = [&](const std::string& name) -> const Material& { return test::materialNamed(scene, name); };
   EXPECT_FLOAT_EQ(material("Offset U").baseColorTexture.offset.x, 0.5f);
   EXPECT_FLOAT_EQ(material("Offset V").baseColorTexture.offset.y, 0.5f);
   EXPECT_NEAR(material("Rotation").baseColorTexture.rotation, 0.39269908f, 1e-6f);
@@ -429,8 +425,7 @@ TEST(SceneImport, GltfTextureTransformAppliesToEverySlot) {
   std::ofstream(dir / "slots.gltf") << doc.dump();
   Scene scene;
   importMeshFile((dir / "slots.gltf").string(), scene);
-  const auto& names = scene.materialNames();
-  const Material& m = scene.materials()[size_t(std::find(names.begin(), names.end(), "Offset U") - names.begin())];
+  const Material& m = test::materialNamed(scene, "Offset U");
   EXPECT_EQ(m.type, MaterialType::Microfacet);
   for (const TextureRef* ref : {&m.normalTexture, &m.emissiveTexture, &m.occlusionTexture, &m.metallicRoughnessTexture}) {
     EXPECT_TRUE(ref->present());
@@ -446,12 +441,7 @@ TEST(SceneImport, GltfMetallicRoughnessAndEmissiveTexturesLoad) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "assimp-testmodels is not installed";
   Scene scene;
   importMeshFile(path, scene);
-  auto material = [&](const std::string& name) -> const Material& {
-    const auto& names = scene.materialNames();
-    size_t i = size_t(std::find(names.begin(), names.end(), name) - names.begin());
-    EXPECT_LT(i, names.size()) << name;
-    return scene.materials()[std::min(i, names.size() - 1)];
-  };
+  auto material = [&](const std::string& name) -> const Material& { return test::materialNamed(scene, name); };
   const Material& base = material("Simple_Base");
   EXPECT_EQ(base.type, MaterialType::Microfacet);
   EXPECT_NEAR(base.roughness, 0.44f, 1e-6f);

@@ -7,17 +7,14 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "test_scenes.h"
 
 namespace pvr {
 namespace {
 
 const std::string kData = PVR_TEST_DATA;
 
-const Material& materialNamed(const Scene& s, const std::string& name) {
-  for (size_t i = 0; i < s.materials().size(); ++i)
-    if (s.materialNames()[i] == name) return s.materials()[i];
-  throw std::runtime_error("no material " + name);
-}
+using test::materialNamed;
 
 std::string errorOf(const std::function<void()>& f) {
   try {

@@ -1,8 +1,18 @@
 #pragma once
 // Scenes built in code for analytic tests.
+#include <stdexcept>
+#include <string>
+
 #include "pvr/scene/scene.h"
 
 namespace pvr::test {
+
+// A scene's material by name; throws (failing the test) when there is none.
+inline const Material& materialNamed(const Scene& s, const std::string& name) {
+  for (size_t i = 0; i < s.materials().size(); ++i)
+    if (s.materialNames()[i] == name) return s.materials()[i];
+  throw std::runtime_error("no material " + name);
+}
 
 // Adds an axis-aligned quad of a unit cube [-0.5, 0.5]^3 whose front face (and normal) points
 // into the cube: the face at coordinate `side` (-1 or +1) of `axis`.

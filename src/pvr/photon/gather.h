@@ -158,8 +158,7 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
         if (scene.sky.present())
           out.radiance += throughput * skyDirectLight(scene, intersector, sp.position, nGeo, nShade, eps, rng, lambertian);
       }
-      out.weight = throughput * brdf;
-      if (m.occlusionTexture.present()) out.weight *= scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
+      out.weight = throughput * brdf * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
       out.position = sp.position;
       out.normal = nGeo;
       break;
@@ -184,8 +183,7 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
           out.radiance += scale * areaDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
         if (full && scene.sky.present())
           out.radiance += scale * skyDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
-        out.weight = scale;
-        if (m.occlusionTexture.present()) out.weight *= scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
+        out.weight = scale * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
         out.position = sp.position;
         out.normal = nGeo;
         out.lobes = gathered;

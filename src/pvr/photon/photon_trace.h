@@ -27,6 +27,16 @@ struct PhotonTraceParams {
   bool storeDirect = false;  ///< also store L D photons (when the photon map alone shades)
 };
 
+// A uniform point on a disk of `radius` around `center` facing `frameNormal`, moved upstream
+// (against `travel`) past the whole scene: where a distant light's or the sky's photon starts.
+PVR_HOST_DEVICE inline Vec3 upstreamDiskPoint(const SceneView& scene, Vec3 center, float radius, Vec3 frameNormal,
+                                              Vec3 travel, float u1, float u2) {
+  Frame frame = Frame::fromNormal(frameNormal);
+  float r = radius * sqrtf(u1), phi = 2.0f * kPi * u2;
+  float back = length(center - scene.sceneCenter) + 2.0f * scene.sceneRadius;
+  return center - travel * back + frame.toWorld({r * cosf(phi), r * sinf(phi), 0.0f});
+}
+
 // The emitted photon i: origin, direction and power.
 PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTraceParams& params, uint32_t i) {
   CounterRng rng(params.seed, i, 0);
@@ -38,16 +48,13 @@ PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTra
   Photon p;
   if (ls.sky) {  // a uniform direction from the upper hemisphere through a disk facing it
     const float n = float(params.photonCount) * ls.pick;
+    const float sinTheta = sqrtf(fmaxf(0.0f, 1.0f - uTheta * uTheta));
     Vec3 toSky = Frame::fromNormal({0, 1, 0}).toWorld(
-        {sqrtf(fmaxf(0.0f, 1.0f - uTheta * uTheta)) * cosf(2.0f * kPi * uPhi),
-         sqrtf(fmaxf(0.0f, 1.0f - uTheta * uTheta)) * sinf(2.0f * kPi * uPhi), uTheta});
+        {sinTheta * cosf(2.0f * kPi * uPhi), sinTheta * sinf(2.0f * kPi * uPhi), uTheta});
     const SkyLight& sky = scene.sky;
     const float radius = sky.photonRadius(scene.sceneRadius);
     const Vec3 center = sky.aimRadius > 0.0f ? sky.aimCenter : scene.sceneCenter;
-    Frame frame = Frame::fromNormal(toSky);
-    float r = radius * sqrtf(u1), phi = 2.0f * kPi * u2;
-    float back = length(center - scene.sceneCenter) + 2.0f * scene.sceneRadius;
-    p.position = center + toSky * back + frame.toWorld({r * cosf(phi), r * sinf(phi), 0.0f});
+    p.position = upstreamDiskPoint(scene, center, radius, toSky, -toSky, u1, u2);
     p.direction = -toSky;
     p.power = sky.radiance * (2.0f * kPi * kPi * radius * radius / n);
     return p;
@@ -56,14 +63,10 @@ PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTra
     const PunctualLight& l = scene.punctualLights[ls.punctual];
     const float n = float(params.photonCount) * ls.pick;
     if (l.kind == PunctualKind::Directional) {
-      Frame frame = Frame::fromNormal(l.direction);
       const bool aimed = l.aimRadius > 0.0f;
       const float radius = aimed ? l.aimRadius : scene.sceneRadius;
       const Vec3 center = aimed ? l.position : scene.sceneCenter;
-      float r = radius * sqrtf(u1), phi = 2.0f * kPi * u2;
-      // Upstream of everything: the disk's centre moved back past the whole scene.
-      float back = length(center - scene.sceneCenter) + 2.0f * scene.sceneRadius;
-      p.position = center - l.direction * back + frame.toWorld({r * cosf(phi), r * sinf(phi), 0.0f});
+      p.position = upstreamDiskPoint(scene, center, radius, l.direction, l.direction, u1, u2);
       p.direction = l.direction;
       p.power = l.intensity * (kPi * radius * radius / n);
       return p;

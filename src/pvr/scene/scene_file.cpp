@@ -102,6 +102,16 @@ void applyCamera(const json& cam, StereoRig& rig) {
   }
 }
 
+// A sun's or sky's optional aim (`what`: "sun" or "sky"): both keys or neither, a positive radius.
+void readAim(const json& light, const std::string& what, Vec3& center, float& radius) {
+  if (light.contains("aim_center") != light.contains("aim_radius"))
+    throw Error("a " + what + "'s aim needs both aim_center and aim_radius");
+  if (!light.contains("aim_center")) return;
+  center = vec3(light["aim_center"], what + " aim_center");
+  radius = number(light["aim_radius"], what + " aim_radius");
+  if (!(radius > 0.0f)) throw Error(what + " aim_radius must be positive");
+}
+
 Scene loadJsonScene(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error("cannot open '" + path + "'");
@@ -171,13 +181,7 @@ Scene loadJsonScene(const std::string& path) {
             checkKeys(l, "a sun", {"sun", "irradiance", "aim_center", "aim_radius"});
             p.kind = PunctualKind::Directional;
             p.direction = vec3(l["sun"], "light sun") * -1.0f;  // the file gives the way to the sun
-            if (l.contains("aim_center") != l.contains("aim_radius"))
-              throw Error("a sun's aim needs both aim_center and aim_radius");
-            if (l.contains("aim_center")) {
-              p.position = vec3(l["aim_center"], "sun aim_center");
-              p.aimRadius = number(l["aim_radius"], "sun aim_radius");
-              if (!(p.aimRadius > 0.0f)) throw Error("sun aim_radius must be positive");
-            }
+            readAim(l, "sun", p.position, p.aimRadius);
           }
           const char* amount = p.kind == PunctualKind::Directional ? "irradiance" : "intensity";
           p.intensity = vec3(l.value(amount, json::array({1, 1, 1})), std::string("light ") + amount);
@@ -188,13 +192,7 @@ Scene loadJsonScene(const std::string& path) {
           checkKeys(l, "a sky", {"sky", "aim_center", "aim_radius"});
           SkyLight sky;
           sky.radiance = vec3(l["sky"], "light sky");
-          if (l.contains("aim_center") != l.contains("aim_radius"))
-            throw Error("a sky's aim needs both aim_center and aim_radius");
-          if (l.contains("aim_center")) {
-            sky.aimCenter = vec3(l["aim_center"], "sky aim_center");
-            sky.aimRadius = number(l["aim_radius"], "sky aim_radius");
-            if (!(sky.aimRadius > 0.0f)) throw Error("sky aim_radius must be positive");
-          }
+          readAim(l, "sky", sky.aimCenter, sky.aimRadius);
           if (scene.sky().present()) throw Error("a scene has at most one sky");
           scene.setSky(sky);
           continue;

@@ -182,12 +182,17 @@ struct SceneView {
     return rayConeLod(uvArea(prim, ref), t.width, t.height, triangleArea(prim), coneWidth, cosTheta);
   }
 
+  // A texture at a hit, at the level a ray cone `coneWidth` wide arriving at cosTheta picks.
+  PVR_HOST_DEVICE Rgba sampleAtCone(const TextureRef& ref, uint32_t prim, float u, float v, float coneWidth,
+                                    float cosTheta) const {
+    return sampleRef(ref, prim, u, v, textureLod(ref, prim, coneWidth, cosTheta));
+  }
+
   // The material's colour at a hit: the constant albedo times its base-colour texture.
   PVR_HOST_DEVICE Vec3 albedoAt(const Material& m, uint32_t prim, float u, float v, float coneWidth = 0.0f,
                                 float cosTheta = 1.0f) const {
     if (!m.baseColorTexture.present()) return m.albedo;
-    float lod = textureLod(m.baseColorTexture, prim, coneWidth, cosTheta);
-    return m.albedo * sampleRef(m.baseColorTexture, prim, u, v, lod).rgb;
+    return m.albedo * sampleAtCone(m.baseColorTexture, prim, u, v, coneWidth, cosTheta).rgb;
   }
 
   // A microfacet material's BSDF at a hit seen from wo (unit, away from the surface), its factors
@@ -205,20 +210,17 @@ struct SceneView {
     b.baseColor = albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, cosTheta);
     float metallic = m.metallic, roughness = m.roughness;
     if (m.metallicRoughnessTexture.present()) {
-      float lod = textureLod(m.metallicRoughnessTexture, hit.primId, coneWidth, cosTheta);
-      Vec3 t = sampleRef(m.metallicRoughnessTexture, hit.primId, hit.u, hit.v, lod).rgb;
+      Vec3 t = sampleAtCone(m.metallicRoughnessTexture, hit.primId, hit.u, hit.v, coneWidth, cosTheta).rgb;
       roughness *= t.y;
       metallic *= t.z;
     }
     if (m.shininessTexture.present()) {  // OBJ map_Ns: Blinn-Phong's exponent, matched as alpha = sqrt(2 / (Ns + 2))
-      float lod = textureLod(m.shininessTexture, hit.primId, coneWidth, cosTheta);
-      float ns = m.shininess * sampleRef(m.shininessTexture, hit.primId, hit.u, hit.v, lod).rgb.x;
+      float ns = m.shininess * sampleAtCone(m.shininessTexture, hit.primId, hit.u, hit.v, coneWidth, cosTheta).rgb.x;
       roughness = sqrtf(sqrtf(2.0f / (fmaxf(ns, 0.0f) + 2.0f)));
     }
     b.specularF0 = m.specularF0;
     if (m.specularTexture.present()) {
-      float lod = textureLod(m.specularTexture, hit.primId, coneWidth, cosTheta);
-      b.specularF0 *= luminance(sampleRef(m.specularTexture, hit.primId, hit.u, hit.v, lod).rgb);
+      b.specularF0 *= luminance(sampleAtCone(m.specularTexture, hit.primId, hit.u, hit.v, coneWidth, cosTheta).rgb);
     }
     b.metallic = fminf(fmaxf(metallic, 0.0f), 1.0f);
     roughness = fminf(fmaxf(roughness, 0.0f), 1.0f);
@@ -235,16 +237,14 @@ struct SceneView {
   PVR_HOST_DEVICE Vec3 emissionAt(const Material& m, uint32_t prim, float u, float v, float coneWidth = 0.0f,
                                   float cosTheta = 1.0f) const {
     if (!m.emissiveTexture.present()) return m.emission;
-    float lod = textureLod(m.emissiveTexture, prim, coneWidth, cosTheta);
-    return m.emission * sampleRef(m.emissiveTexture, prim, u, v, lod).rgb;
+    return m.emission * sampleAtCone(m.emissiveTexture, prim, u, v, coneWidth, cosTheta).rgb;
   }
 
   // glTF's ambient occlusion factor 1 + strength (texel - 1), 1 without a texture.
   PVR_HOST_DEVICE float occlusionAt(const Material& m, uint32_t prim, float u, float v, float coneWidth = 0.0f,
                                     float cosTheta = 1.0f) const {
     if (!m.occlusionTexture.present()) return 1.0f;
-    float lod = textureLod(m.occlusionTexture, prim, coneWidth, cosTheta);
-    float ao = sampleRef(m.occlusionTexture, prim, u, v, lod).rgb.x;
+    float ao = sampleAtCone(m.occlusionTexture, prim, u, v, coneWidth, cosTheta).rgb.x;
     return fminf(fmaxf(1.0f + m.occlusionStrength * (ao - 1.0f), 0.0f), 1.0f);
   }
 
