@@ -739,10 +739,11 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
   int failures = 0;
   std::printf("\nTextured scenes: full shading (direct light by shadow rays, photon map for the rest), hash grid, "
               "radius estimate, hybrid kernel, %d timed frames per cell after %d of warm-up; error = mean absolute "
-              "difference over the mean against the separate frame with 16x the photons\n\n",
+              "difference over the mean against the separate frame with 16x the photons and a shadow ray to every light; "
+              "eye rays and density: both eyes' stages within the eye passes\n\n",
               args.frames, args.warmup);
   std::printf("| scene | eyes | photons | radius (of diagonal) | variant | frame (mean / p99) | trace | build | left eye | "
-              "right eye | error L / R | check |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "right eye | eye rays | density | error L / R | check |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& name : splitList(args.scenes)) {
     Scene scene;
     try {
@@ -766,38 +767,49 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
     o.gather.mode = ShadingMode::Full;
     RenderOptions reference = o;
     reference.photonsX = reference.photonsY = 2048;
+    reference.gather.punctualShadowRays = 0;  // no light-selection noise in the reference
     FrameResult converged = renderer->render(rig, reference, true);
     struct Cell {
       const char* name;
       FrameRenderer* renderer;
       StereoMode stereo;
+      int shadowRays;  ///< to the punctual lights per gather point (0: one per light)
     };
-    const Cell cells[] = {{"separate", renderer.get(), StereoMode::Separate},
-                          {"gather", renderer.get(), StereoMode::Gather},
-                          {"gather, no colour textures", plainRenderer.get(), StereoMode::Gather}};
+    // The textured cells choose one punctual light per shadow ray; "every light" shows what one
+    // exact ray per light costs, the untextured cell what texture sampling costs.
+    const Cell allCells[] = {{"separate", renderer.get(), StereoMode::Separate, 1},
+                             {"gather", renderer.get(), StereoMode::Gather, 1},
+                             {"gather, a ray to every light", renderer.get(), StereoMode::Gather, 0},
+                             {"gather, no colour textures", plainRenderer.get(), StereoMode::Gather, 1}};
+    std::vector<Cell> cells(allCells, allCells + 2);
+    if (scene.punctualLights().size() > 1) cells.push_back(allCells[2]);
+    if (scene.textureCount() > 0) cells.push_back(allCells[3]);  // no textures: nothing to leave out
     const FrameRays rays = countFrameRays(scene, rig, o);
-    double eyePassMs[3] = {0, 0, 0};
-    const int cellCount = scene.textureCount() > 0 ? 3 : 2;  // no textures: nothing to leave out
-    for (int c = 0; c < cellCount; ++c) {
+    double gatherEyePassMs = 0, untexturedEyePassMs = 0;
+    for (size_t c = 0; c < cells.size(); ++c) {
       RenderOptions co = o;
       co.stereo = cells[c].stereo;
+      co.gather.punctualShadowRays = cells[c].shadowRays;
       CellResult r = timeCell(*cells[c].renderer, rig, co, args.warmup, args.frames);
-      eyePassMs[c] = r.stages.eyePass.mean;
+      const bool untextured = cells[c].renderer == plainRenderer.get();
+      if (c == 1) gatherEyePassMs = r.stages.eyePass.mean;
+      if (untextured) untexturedEyePassMs = r.stages.eyePass.mean;
       double error[2] = {compareImages(converged.eyes[0].image, r.last.eyes[0].image).relativeMad,
                          compareImages(converged.eyes[1].image, r.last.eyes[1].image).relativeMad};
       // Textured frames must converge towards the reference (a broken path shows here); the
       // untextured one must differ from it (textures do something).
-      bool ok = c < 2 ? error[0] < 0.5 && error[1] < 0.5 : error[0] > 0.01;
+      bool ok = !untextured ? error[0] < 0.5 && error[1] < 0.5 : error[0] > 0.01;
       failures += ok ? 0 : 1;
-      std::printf("| %s | %dx%d | 512x512 | %g (%.2f %%) | %s | %s | %s | %s | %s | %s | %.3f / %.3f | %s |\n",
+      std::printf("| %s | %dx%d | 512x512 | %g (%.2f %%) | %s | %s | %s | %s | %s | %s | %.2f | %.2f | %.3f / %.3f | %s |\n",
                   scene.name.c_str(), rig.width, rig.height, radius, 100.0 * radius / diagonal,
                   cells[c].name, meanP99(r.frame, 2).c_str(), meanP99(r.stages.trace, 2).c_str(),
                   meanP99(r.stages.build, 2).c_str(), meanP99(r.stages.eye[0], 2).c_str(), meanP99(r.stages.eye[1], 2).c_str(),
-                  error[0], error[1], ok ? "ok" : "MISMATCH");
+                  r.stages.rays.mean, r.stages.density.mean, error[0], error[1], ok ? "ok" : "MISMATCH");
       nlohmann::json cell = r.latencyJson();
       cell.update({{"suite", "scenes"}, {"scene", scene.name}, {"variant", cells[c].name}, {"backend", renderer->name()},
                    {"device", renderer->deviceName()}, {"eye_size", {rig.width, rig.height}}, {"photons", 512 * 512},
                    {"radius", radius}, {"radius_of_diagonal", radius / diagonal},
+                   {"punctual_shadow_rays", cells[c].shadowRays}, {"punctual_lights", scene.punctualLights().size()},
                    {"triangles", scene.triangleCount()}, {"textures", scene.textureCount()},
                    {"error_vs_16x_photons", {error[0], error[1]}}, {"check", ok ? "ok" : "MISMATCH"}});
       if (c == 0) {  // rays per second of the separate frame's stages (mean stage times)
@@ -812,10 +824,11 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
       }
       json.push_back(cell);
     }
-    if (eyePassMs[2] > 0)
+    if (untexturedEyePassMs > 0)
       std::printf("| %s | texture sampling adds %.1f %% to the eye pass (gather: %.2f ms against %.2f ms without colour "
                   "textures) |\n",
-                  scene.name.c_str(), 100.0 * (eyePassMs[1] / eyePassMs[2] - 1.0), eyePassMs[1], eyePassMs[2]);
+                  scene.name.c_str(), 100.0 * (gatherEyePassMs / untexturedEyePassMs - 1.0), gatherEyePassMs,
+                  untexturedEyePassMs);
   }
   return failures;
 }

@@ -10,7 +10,8 @@ using namespace cuda;
 namespace {
 
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
-__global__ void primaryRaysKernel(BvhIntersector intersector, EyeCamera camera, Hit* hits) {
+__global__ void primaryRaysKernel(BvhIntersector sceneIntersector, EyeCamera camera, Hit* hits) {
+  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   Hit hit;
@@ -28,8 +29,9 @@ __device__ inline bool primaryPoint(const SceneView& scene, const EyeCamera& cam
   return true;
 }
 
-__global__ void shadowRaysKernel(SceneView scene, BvhIntersector intersector, EyeCamera camera, const Hit* hits,
+__global__ void shadowRaysKernel(SceneView scene, BvhIntersector sceneIntersector, EyeCamera camera, const Hit* hits,
                                  uint8_t* occluded) {
+  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   SurfacePoint sp;
@@ -44,8 +46,9 @@ __global__ void shadowRaysKernel(SceneView scene, BvhIntersector intersector, Ey
   occluded[pixel] = intersector.occluded({origin, d / dist}, dist * (1.0f - 1e-3f)) ? 1 : 0;
 }
 
-__global__ void diffuseRaysKernel(SceneView scene, BvhIntersector intersector, EyeCamera camera, const Hit* hits,
+__global__ void diffuseRaysKernel(SceneView scene, BvhIntersector sceneIntersector, EyeCamera camera, const Hit* hits,
                                   Hit* out) {
+  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   SurfacePoint sp;

@@ -84,6 +84,8 @@ expect_error "--ipd: the IPD must be" render cornell --ipd inf --eye-size 8x8
 expect_error "--spp: samples per pixel" render cornell --spp 5000 --eye-size 8x8
 expect_error "--photon-depth: the photon depth" render cornell --photon-depth 0 --eye-size 8x8
 expect_error "--specular-depth: the specular depth" render cornell --specular-depth 65 --eye-size 8x8
+expect_error "--shadow-rays: the shadow rays per point" render cornell --shadow-rays -1 --eye-size 8x8
+expect_error "--shadow-rays: the shadow rays per point" render cornell --shadow-rays 65 --eye-size 8x8
 expect_error "--photons: too many photons" render cornell --photons 8193x8192 --eye-size 8x8
 expect_error "--k" render cornell --estimator knn --k 0 --eye-size 8x8
 expect_error "--k" render cornell --estimator knn --k 65 --eye-size 8x8

@@ -230,6 +230,75 @@ TEST(Lights, DistantLightIsIrradianceTimesCosine) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(L[c], sun.intensity[c] * 0.8f / kPi, 1e-5f);
 }
 
+// Several punctual lights with one shadow ray chosen among them by unoccluded contribution: where
+// every light is visible the estimate's luminance is the exact sum's for every random number (no
+// selection noise but the lights' colours); the mean over many paths is the exact sum, per
+// channel, where every light is visible and where a blocker hides one (unbiased).
+TEST(Lights, OneShadowRayAmongManyLightsIsExactWhenVisibleAndUnbiasedWhenNot) {
+  Scene scene;
+  Material white;
+  white.albedo = {1, 1, 1};
+  uint32_t id = scene.addMaterial(white, "floor");
+  scene.addMesh("floor", {{-4, 0, -4}, {4, 0, -4}, {4, 0, 4}, {-4, 0, 4}}, {}, {0, 2, 1, 0, 3, 2}, id);
+  // A small roof over x in [1.8, 2.2] at y = 1: it hides the lamp straight above (2, 0, 0) only.
+  scene.addMesh("roof", {{1.8f, 1, -0.2f}, {2.2f, 1, -0.2f}, {2.2f, 1, 0.2f}, {1.8f, 1, 0.2f}}, {}, {0, 1, 2, 0, 2, 3}, id);
+  PunctualLight lamp, spot, sun;
+  lamp.position = {2, 1.5f, 0};
+  lamp.intensity = {6, 5, 4};
+  spot.kind = PunctualKind::Spot;
+  spot.position = {-1, 2, 0.5f};
+  spot.direction = {0, -1, 0};
+  spot.intensity = {10, 10, 10};
+  spot.cosInner = 0.2f, spot.cosOuter = 0.1f;
+  sun.kind = PunctualKind::Directional;
+  sun.direction = normalize(Vec3(-0.3f, -1.0f, 0.2f));
+  sun.intensity = {1, 1.2f, 1.5f};
+  scene.addPunctualLight(lamp, "lamp");
+  scene.addPunctualLight(spot, "spot");
+  scene.addPunctualLight(sun, "sun");
+  scene.finalize();
+  EmbreeIntersector intersector(scene);
+  auto radianceAt = [&](Vec3 p, int shadowRays, uint32_t stream) {
+    GatherParams params;
+    params.punctualShadowRays = shadowRays;
+    Ray down{p + Vec3(0, 0.5f, 0.1f), normalize(Vec3(0, -0.5f, -0.1f))};
+    CounterRng rng(7, stream, 0);
+    return traceToGatherPoint(scene.view(), intersector, params, down, rng).radiance;
+  };
+  const Vec3 open{-0.5f, 0, 1.0f}, underRoof{2.0f, 0, 0};
+  const Vec3 exactOpen = radianceAt(open, 0, 0);
+  ASSERT_GT(exactOpen.x, 0.0f);
+  Vec3 meanOpen{0, 0, 0};
+  for (uint32_t i = 0; i < 4000; ++i) {
+    Vec3 one = radianceAt(open, 1, i);
+    EXPECT_NEAR(luminance(one), luminance(exactOpen), 1e-5f * luminance(exactOpen)) << i;
+    meanOpen += one * (1.0f / 4000);
+  }
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(meanOpen[c], exactOpen[c], 0.01f * exactOpen[c]);
+  EXPECT_EQ(radianceAt(open, 3, 5), exactOpen);  // a ray per light: the exact evaluation itself
+  // Under the roof the exact evaluation is every light's unoccluded contribution but the lamp's.
+  const Vec3 exactShaded = radianceAt(underRoof, 0, 0);
+  auto lambertian = [](Vec3) { return Vec3(kInvPi); };
+  Vec3 visible{0, 0, 0};
+  for (uint32_t k = 1; k < 3; ++k)
+    visible += punctualContribution(scene.view(), k, underRoof, {0, 1, 0}, {0, 1, 0}, false, 1e-4f, lambertian).value;
+  const Vec3 hidden = punctualContribution(scene.view(), 0, underRoof, {0, 1, 0}, {0, 1, 0}, false, 1e-4f, lambertian).value;
+  ASSERT_GT(hidden.x, 0.2f * visible.x);
+  for (int c = 0; c < 3; ++c) ASSERT_NEAR(exactShaded[c], visible[c], 1e-4f * visible[c]);
+  const int paths = 40000;
+  for (int rays : {1, 2}) {
+    Vec3 mean{0, 0, 0};
+    int zero = 0;
+    for (int i = 0; i < paths; ++i) {
+      Vec3 L = radianceAt(underRoof, rays, uint32_t(i));
+      mean += L * (1.0f / paths);
+      zero += isBlack(L);
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean[c], exactShaded[c], 0.02f * exactShaded[c]) << rays;
+    if (rays == 1) EXPECT_GT(zero, paths / 10);  // the rays that chose the hidden lamp
+  }
+}
+
 // The photon map alone (all photons stored) estimates the same irradiance, within its noise.
 TEST(Lights, PhotonMapAgreesWithTheDirectIrradiance) {
   PunctualLight lamp;

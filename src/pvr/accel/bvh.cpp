@@ -33,7 +33,6 @@ struct BuildInput {
 };
 
 constexpr unsigned kMaxLeafSize = 4;
-constexpr unsigned kMaxDepth = 48;  // below the traversal stack's 64 entries
 
 void* createInner(RTCThreadLocalAllocator alloc, unsigned int childCount, void*) {
   auto* node = static_cast<BuildInner*>(rtcThreadLocalAlloc(alloc, sizeof(BuildInner), 16));
@@ -223,7 +222,7 @@ Bvh Bvh::build(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& i
     args.buildQuality = RTC_BUILD_QUALITY_HIGH;  // SAH with spatial splits
     args.buildFlags = RTC_BUILD_FLAG_NONE;
     args.maxBranchingFactor = 2;
-    args.maxDepth = kMaxDepth;
+    args.maxDepth = kBvhMaxDepth;
     args.sahBlockSize = 1;
     args.minLeafSize = 1;
     args.maxLeafSize = kMaxLeafSize;

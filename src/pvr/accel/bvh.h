@@ -16,6 +16,9 @@ namespace pvr {
 
 class Scene;
 
+// The builder's depth limit, and so the entries a traversal stack needs (one per level).
+constexpr unsigned kBvhMaxDepth = 48;
+
 struct alignas(16) BvhNode {
   // Child c's box: lower at bounds[6c .. 6c+2], upper at bounds[6c+3 .. 6c+5].
   float bounds[12];

@@ -79,6 +79,7 @@ struct RenderArgs {
   uint32_t seed = 1;
   int photonDepth = 8;
   int specularDepth = 8;
+  int shadowRays = 1;  // to the punctual lights per gather point; 0: one per light
   std::string shading = "full";
   bool foveated = false;
   std::string mask;          // empty: made for the rig at start
@@ -173,6 +174,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
       ->capture_default_str();
   cmd.add_option("--seed", a.seed, "Seed of the counter-based random numbers")->capture_default_str();
   cmd.add_option("--photon-depth", a.photonDepth, "Maximum surface interactions per photon path")->capture_default_str();
+  cmd.add_option("--shadow-rays", a.shadowRays,
+                 "Shadow rays to the point/spot/sun lights per shaded point, each to one light chosen by its "
+                 "unoccluded contribution (unbiased); 0: one exact ray to every light")
+      ->capture_default_str();
 }
 
 // The render options from their spellings: syntax here, ranges in validateOptions (one place).
@@ -209,6 +214,7 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   o.gather.seed = a.seed;
   o.maxPhotonDepth = a.photonDepth;
   o.gather.maxSpecularDepth = a.specularDepth;
+  o.gather.punctualShadowRays = a.shadowRays;
   if (a.shading == "full") o.gather.mode = ShadingMode::Full;
   else if (a.shading == "photons") o.gather.mode = ShadingMode::PhotonMapOnly;
   else throw Error("--shading must be full or photons, got '" + a.shading + "'");
@@ -285,10 +291,10 @@ int runRender(const RenderArgs& a) {
   std::printf("scene %s: %u triangles, %u emitting, %zu point/spot/sun lights, %u textures; eyes %dx%d, IPD %.1f mm\n",
               scene.name.c_str(), scene.triangleCount(), scene.lightTriangleCount(), scene.punctualLights().size(),
               scene.textureCount(), rig.width, rig.height, rig.ipd * 1000.0f);
-  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, seed %u\n", options.photonsX,
+  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, %d shadow rays per point (0: one per light), seed %u\n", options.photonsX,
               options.photonsY, options.gather.density.radius, a.map.c_str(), a.estimator.c_str(),
               options.gather.density.estimator == Estimator::Knn ? (" (k=" + std::to_string(a.k) + ")").c_str() : "",
-              options.gather.samplesPerPixel, options.gather.seed);
+              options.gather.samplesPerPixel, options.gather.punctualShadowRays, options.gather.seed);
   std::printf("backend %s: %s%s\n", renderer->name().c_str(), renderer->deviceName().c_str(),
               renderer->name() == "cuda" ? (", " + std::string(densityKernelName(options.kernel)) + " kernel").c_str() : "");
   const char* names[2] = {"left", "right"};

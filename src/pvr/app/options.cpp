@@ -33,6 +33,7 @@ const char* flagOf(RenderOption option) {
     case RenderOption::K: return "--k";
     case RenderOption::SamplesPerPixel: return "--spp";
     case RenderOption::SpecularDepth: return "--specular-depth";
+    case RenderOption::ShadowRays: return "--shadow-rays";
     case RenderOption::EyeSize: return "--eye-size";
     case RenderOption::Ipd: return "--ipd";
     case RenderOption::Kernel: return "--kernel";

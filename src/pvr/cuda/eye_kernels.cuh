@@ -2,6 +2,7 @@
 // Device helpers shared by the eye-pass kernels (full resolution, foveated, density, scatter, and
 // the ray-throughput benchmark): 8x8 pixel tiles, per-pixel outputs, the stereo role's paths.
 #include "pvr/cuda/eye_pass.cuh"
+#include "pvr/cuda/traversal_stack.cuh"
 
 namespace pvr::cuda {
 

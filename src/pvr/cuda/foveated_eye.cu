@@ -30,11 +30,14 @@ struct VertexInUse {
 // Foveated: the listed vertices' eye rays. Under stereo reuse, those on pixel centres take the
 // pixel path: the left eye (Source) records their surfaces, the right (Reuser) may reuse them and
 // counts those it did. Separate rendering keeps the leaner per-position path (same result).
+constexpr int kVertexBlock = 128;
+
 template <StereoRole R>
-__global__ void vertexRaysKernel(SceneView scene, BvhIntersector intersector, GatherParams params, EyeCamera camera,
+__global__ void vertexRaysKernel(SceneView scene, BvhIntersector sceneIntersector, GatherParams params, EyeCamera camera,
                                  Eye eye, DeviceMaskView mask, int gazeX, int gazeY, const uint32_t* list,
                                  const uint32_t* listed, StereoReuseView reuse, EyeOutputs out, GatherPointStore points,
                                  float* inverseDepths) {
+  const BvhIntersector intersector = withSharedStack<kVertexBlock>(sceneIntersector);
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= *listed) return;
   uint32_t vertex = list[i];
@@ -110,7 +113,7 @@ void GpuEyePass::renderFoveated(const DeviceScene& scene, DeviceMap map, const E
     auto* vertexRays = pass.role == StereoRole::Reuser   ? vertexRaysKernel<StereoRole::Reuser>
                        : pass.role == StereoRole::Source ? vertexRaysKernel<StereoRole::Source>
                                                          : vertexRaysKernel<StereoRole::Alone>;
-    launch("eye rays (mask vertices)", vertexRays, blocksFor(mask.vertexCount, 128), 128, 0, stream, scene.view,
+    launch("eye rays (mask vertices)", vertexRays, blocksFor(mask.vertexCount, kVertexBlock), kVertexBlock, 0, stream, scene.view,
            scene.intersector, params, camera, eye, mask, gazeX, gazeY, vertexList_.data(), count, reuse, out,
            vertexPoints_.view(), vertexInverseDepths_.data());
   }

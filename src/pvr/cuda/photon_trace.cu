@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "pvr/cuda/photon_trace.cuh"
+#include "pvr/cuda/traversal_stack.cuh"
 
 namespace pvr::cuda {
 namespace {
@@ -16,8 +17,11 @@ PVR_HOST_DEVICE inline float floatFromOrdered(int i) {
   return floatFromBits(uint32_t(i >= 0 ? i : i ^ 0x7FFFFFFF));
 }
 
-__global__ void tracePhotonsKernel(SceneView scene, BvhIntersector intersector, PhotonTraceParams params,
+constexpr int kPhotonBlock = 128;
+
+__global__ void tracePhotonsKernel(SceneView scene, BvhIntersector sceneIntersector, PhotonTraceParams params,
                                    uint32_t first, uint32_t n, Photon* slots, uint32_t* counts, int* bounds) {
+  const BvhIntersector intersector = withSharedStack<kPhotonBlock>(sceneIntersector);
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   Bounds3 b;
   if (i < n) {
@@ -79,7 +83,7 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
   for (uint32_t first = 0; first < params.photonCount; first += chunk) {
     uint32_t n = std::min(chunk, params.photonCount - first);
     PVR_CUDA_CHECK(cudaMemsetAsync(counts_.data() + n, 0, sizeof(uint32_t), stream));
-    launch("photon trace", tracePhotonsKernel, blocksFor(n, 128), 128, 0, stream, scene.view, scene.intersector, params,
+    launch("photon trace", tracePhotonsKernel, blocksFor(n, kPhotonBlock), kPhotonBlock, 0, stream, scene.view, scene.intersector, params,
            first, n, slots_.data(), counts_.data(), summary_.data());
     size_t bytes = temp_.capacity();
     PVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, counts_.data(), offsets_.data(), n + 1, stream));

@@ -23,6 +23,9 @@ struct GatherParams {
   ShadingMode mode = ShadingMode::Full;
   int maxSpecularDepth = 8;  ///< mirror/glass bounces followed from the eye
   int samplesPerPixel = 1;
+  // Shadow rays to the punctual lights per gather point, each to one light chosen by its
+  // unoccluded contribution (punctualDirectLight); 0: one exact ray to every light.
+  int punctualShadowRays = 1;
   uint32_t seed = 1;
 };
 
@@ -58,28 +61,72 @@ struct GatherPoint {
   }
 };
 
-// Direct light from every point, spot and distant light at a surface point, one exact shadow ray
-// each (no selection noise among a handful of lights; they can never be hit by a ray). `bsdf`
-// gives f(wi) for a direction to the light; `twoSided` lets light arrive from behind (transmission).
+// What a punctual light would add at a surface point if its shadow ray is unblocked.
+struct ShadowedContribution {
+  Vec3 value{0, 0, 0};
+  Ray shadow{};
+  float distance = 0.0f;
+};
+
+// Light k's unoccluded contribution f E |cos| at a point. `bsdf` gives f(wi) for a direction to
+// the light; `twoSided` lets light arrive from behind (transmission).
+template <class Bsdf>
+PVR_HOST_DEVICE ShadowedContribution punctualContribution(const SceneView& scene, uint32_t k, Vec3 position, Vec3 nGeo,
+                                                          Vec3 nShade, bool twoSided, float eps, const Bsdf& bsdf) {
+  ShadowedContribution c;
+  LightSample ls;
+  ls.punctual = int(k);
+  ls.pick = 1.0f;
+  PunctualIllumination li = illuminate(scene, ls, position, eps);
+  float cosSurface = dot(nShade, li.wi), cosGeometric = dot(nGeo, li.wi);
+  bool front = cosSurface > 0.0f && cosGeometric > 0.0f;
+  bool back = twoSided && cosSurface < 0.0f && cosGeometric < 0.0f;
+  if ((!front && !back) || isBlack(li.irradiance)) return c;
+  c.value = bsdf(li.wi) * li.irradiance * fabsf(cosSurface);
+  c.shadow = Ray{position + (front ? nGeo : -nGeo) * eps, li.wi};
+  c.distance = li.shadowDistance;
+  return c;
+}
+
+// Direct light from the point, spot and distant lights at a surface point. With shadowRays == 0,
+// or at least one ray per light, every light gets one exact shadow ray. Otherwise each of the
+// shadowRays rays goes to one light chosen in proportion to the luminance of its unoccluded
+// contribution here (its power and solid angle, the cosine and the BSDF): unbiased, and exact in
+// luminance wherever every light is visible, so the noise is the visibility's and the lights' hues. The choice is one
+// weighted-reservoir pass over the lights with one random number, so nothing is stored per light.
 template <class Intersector, class Bsdf>
 PVR_HOST_DEVICE Vec3 punctualDirectLight(const SceneView& scene, const Intersector& intersector, Vec3 position,
-                                         Vec3 nGeo, Vec3 nShade, bool twoSided, float eps, const Bsdf& bsdf) {
+                                         Vec3 nGeo, Vec3 nShade, bool twoSided, float eps, const Bsdf& bsdf,
+                                         int shadowRays, CounterRng& rng) {
   Vec3 sum{0, 0, 0};
-  for (uint32_t k = 0; k < scene.punctualCount; ++k) {
-    LightSample ls;
-    ls.punctual = int(k);
-    ls.pick = 1.0f;
-    PunctualIllumination li = illuminate(scene, ls, position, eps);
-    float cosSurface = dot(nShade, li.wi), cosGeometric = dot(nGeo, li.wi);
-    bool front = cosSurface > 0.0f && cosGeometric > 0.0f;
-    bool back = twoSided && cosSurface < 0.0f && cosGeometric < 0.0f;
-    if ((!front && !back) || isBlack(li.irradiance)) continue;
-    Vec3 f = bsdf(li.wi);
-    if (isBlack(f)) continue;
-    Ray shadow{position + (front ? nGeo : -nGeo) * eps, li.wi};
-    if (!intersector.occluded(shadow, li.shadowDistance)) sum += f * li.irradiance * fabsf(cosSurface);
+  if (shadowRays <= 0 || uint32_t(shadowRays) >= scene.punctualCount) {
+    for (uint32_t k = 0; k < scene.punctualCount; ++k) {
+      ShadowedContribution c = punctualContribution(scene, k, position, nGeo, nShade, twoSided, eps, bsdf);
+      if (!isBlack(c.value) && !intersector.occluded(c.shadow, c.distance)) sum += c.value;
+    }
+    return sum;
   }
-  return sum;
+  for (int s = 0; s < shadowRays; ++s) {
+    float u = rng.uniform();
+    float total = 0.0f, chosenWeight = 0.0f;
+    ShadowedContribution chosen;
+    for (uint32_t k = 0; k < scene.punctualCount; ++k) {
+      ShadowedContribution c = punctualContribution(scene, k, position, nGeo, nShade, twoSided, eps, bsdf);
+      float w = luminance(c.value);
+      if (!(w > 0.0f)) continue;
+      total += w;
+      float p = w / total;
+      if (u < p) {  // take light k; u, rescaled, stays uniform for the lights after it
+        chosen = c, chosenWeight = w;
+        u = u / p;
+      } else {
+        u = (u - p) / (1.0f - p);
+      }
+    }
+    if (chosenWeight > 0.0f && !intersector.occluded(chosen.shadow, chosen.distance))
+      sum += chosen.value * (total / chosenWeight);
+  }
+  return sum * (1.0f / float(shadowRays));
 }
 
 // One sample of the area lights' direct light at a surface point (front side only).
@@ -152,7 +199,8 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
       Vec3 brdf = scene.albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo)) * kInvPi;
       auto lambertian = [&](Vec3) { return brdf; };
       if (full) {
-        out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, nShade, false, eps, lambertian);
+        out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, nShade, false, eps, lambertian,
+                                                                 params.punctualShadowRays, rng);
         if (scene.triangleLightCount > 0)
           out.radiance += throughput * areaDirectLight(scene, intersector, sp.position, nGeo, nShade, eps, rng, lambertian);
         if (scene.sky.present())
@@ -168,7 +216,8 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
       const BsdfParams b = scene.bsdfAt(m, hit, sp, wo, coneWidth);
       if (full)
         out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, b.normal, m.transmits(), eps,
-                                                         [&](Vec3 wi) { return b.eval(wo, wi); });
+                                                         [&](Vec3 wi) { return b.eval(wo, wi); }, params.punctualShadowRays,
+                                                         rng);
       const uint32_t followed = kLobeTransmission | (b.alpha < kGatheredMinAlpha ? uint32_t(kLobeReflection) : 0u);
       float p[3];
       b.lobeProbabilities(dot(b.normal, wo), kLobesAll, p);

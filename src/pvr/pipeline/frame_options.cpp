@@ -43,6 +43,9 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
                       "samples per pixel must be between 1 and " + std::to_string(kMaxSamplesPerPixel));
   if (o.gather.maxSpecularDepth < 0 || o.gather.maxSpecularDepth > kMaxPathDepth)
     throw OptionError(RenderOption::SpecularDepth, "the specular depth must be between 0 and " + std::to_string(kMaxPathDepth));
+  if (o.gather.punctualShadowRays < 0 || o.gather.punctualShadowRays > kMaxShadowRays)
+    throw OptionError(RenderOption::ShadowRays,
+                      "the shadow rays per point must be between 0 (one per light) and " + std::to_string(kMaxShadowRays));
   if ((o.kernel == DensityKernel::SharedMemory || o.kernel == DensityKernel::CellSorted) &&
       o.map != PhotonMapKind::HashGrid)
     throw OptionError(RenderOption::Kernel,

@@ -51,11 +51,12 @@ constexpr int kMaxEyeDimension = 8192;
 constexpr uint64_t kMaxPhotons = uint64_t(1) << 26;  ///< 8192x8192
 constexpr int kMaxSamplesPerPixel = 4096;
 constexpr int kMaxPathDepth = 64;
+constexpr int kMaxShadowRays = 64;
 
 // The option an OptionError is about, so that a front end can name it its own way (the command
 // line names its flag).
 enum class RenderOption : int {
-  Photons, PhotonDepth, Radius, K, SamplesPerPixel, SpecularDepth, EyeSize, Ipd, Kernel, Gaze, TaaBlend,
+  Photons, PhotonDepth, Radius, K, SamplesPerPixel, SpecularDepth, ShadowRays, EyeSize, Ipd, Kernel, Gaze, TaaBlend,
   TaaDepthTolerance, Stereo,
 };
 
