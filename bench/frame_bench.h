@@ -29,6 +29,7 @@ struct FrameBenchArgs {
   std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
   std::string scenes = "scenes/dabrovic-sponza.json,scenes/sibenik.json,cornell-dense";  ///< scenes suite (cornell-dense: the per-ray yardstick); absent meshes: skipped
   float sceneRadius = 0.15f;  ///< scenes suite: the search radius, scene units
+  int referencePasses = 64;   ///< scenes suite: passes of the progressive reference (1024x1024 photons each)
   int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)
   int warmup = 10;
   int k = 32;

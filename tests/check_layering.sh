@@ -20,12 +20,13 @@ declare -A allowed=(
   [pipeline]="photon stereo foveation temporal image scene shading camera geometry math util"
   [cpu]="pipeline photon stereo foveation temporal image scene shading camera geometry math util"
   [cuda]="pipeline accel photon stereo foveation temporal image scene shading camera geometry math util"
+  [reference]="pipeline photon stereo foveation temporal image scene shading camera geometry math util"
   [render]="cpu cuda pipeline photon stereo foveation temporal image scene shading camera geometry math util"
   [loop]="render pipeline photon stereo foveation temporal image scene shading camera geometry math util"
   [vk]="loop cuda image geometry math util"
   [xr]="loop vk render cuda pipeline photon stereo foveation temporal image scene shading camera geometry math util"
   [viewer]="loop vk render cuda pipeline photon stereo foveation temporal image scene shading camera geometry math util"
-  [app]="viewer xr vk loop render cpu cuda pipeline accel photon stereo foveation temporal image scene shading camera geometry math util"
+  [app]="viewer xr vk loop render reference cpu cuda pipeline accel photon stereo foveation temporal image scene shading camera geometry math util"
 )
 failures=0
 for dir in "$src"/*/; do

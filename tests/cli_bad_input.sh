@@ -86,6 +86,16 @@ expect_error "--photon-depth: the photon depth" render cornell --photon-depth 0 
 expect_error "--specular-depth: the specular depth" render cornell --specular-depth 65 --eye-size 8x8
 expect_error "--shadow-rays: the shadow rays per point" render cornell --shadow-rays -1 --eye-size 8x8
 expect_error "--shadow-rays: the shadow rays per point" render cornell --shadow-rays 65 --eye-size 8x8
+ref=(reference cornell --backend cpu --eye-size 8x8 --photons 16x16 --out "$out/ref")
+expect_error "--passes must be between 1" "${ref[@]}" --passes 0
+expect_error "--alpha must be between 0 and 1" "${ref[@]}" --alpha 1
+expect_error "--filter must be box or centre" "${ref[@]}" --filter gauss
+expect_error "--frame is for --trajectory" "${ref[@]}" --frame 2
+expect_error "--frame 9 is past the trajectory" "${ref[@]}" --trajectory "$data/gaze_pursuit.traj" --frame 9
+expect_error "not expected: --foveated" "${ref[@]}" --foveated
+expect_error "no such file" "${ref[@]}" --passes 1 --compare "$out/missing"
+printf 'not an exr' >"$out/bad_left.exr"
+expect_error "as EXR" "${ref[@]}" --passes 1 --eyes left --compare "$out/bad"
 expect_error "--photons: too many photons" render cornell --photons 8193x8192 --eye-size 8x8
 expect_error "--k" render cornell --estimator knn --k 0 --eye-size 8x8
 expect_error "--k" render cornell --estimator knn --k 65 --eye-size 8x8

@@ -42,5 +42,25 @@ expect_render taa "taa_0004_left.png taa_0004_right.exr" --taa --trajectory "$da
 expect_render fovtaa "fovtaa_0000_left.png fovtaa_0004_right.png" --foveated --taa --taa-blend 0.2 --stereo gather \
   --trajectory "$data/gaze_pursuit.traj"
 grep -q "TAA history kept on" "$out/stdout" || { echo "FAIL: no TAA history share printed"; failures=$((failures + 1)); }
+# A viewer's settings file (foveation and TAA on) gives the reference its view; the reference
+# renders every pixel regardless.
+echo '{"foveated": true, "taa": true, "photons": "16x16", "head": {"position": [0.25, 0.1, 1.2], "orientation": [0, 0, 0, 1]}}' \
+  >"$out/view_settings.json"
+if "$exe" reference cornell --backend cpu --eye-size 24x24 --passes 2 --settings "$out/view_settings.json" --out "$out/refset" \
+     >"$out/stdout" 2>"$out/stderr" && grep -q '0.25' "$out/refset.json" && grep -q "256 photons" "$out/stdout"; then
+  echo "ok   (reference with a viewer's settings)"
+else
+  echo "FAIL (reference with a viewer's settings): $(tail -3 "$out/stderr")"
+  failures=$((failures + 1))
+fi
+# The reference of a view, and a render compared against it.
+if "$exe" reference cornell --backend cpu --eye-size 64x72 --photons 32x32 --spp 1 --passes 6 --out "$out/ref" \
+     --compare "$out/full" >"$out/stdout" 2>"$out/stderr" && [ -s "$out/ref_left.exr" ] && [ -s "$out/ref.json" ] &&
+   grep -q '"passes": 6' "$out/ref.json" && grep -q "against it: relMSE" "$out/stdout"; then
+  echo "ok   (reference)"
+else
+  echo "FAIL (reference): $(tail -3 "$out/stderr")"
+  failures=$((failures + 1))
+fi
 [ "$failures" -eq 0 ] && echo "all render modes passed" || echo "$failures render mode(s) failed"
 exit $((failures > 0))

@@ -9,6 +9,8 @@
 #include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/cuda/cuda_frame_backend.h"
 #include "pvr/foveation/mask.h"
+#include "pvr/image/image_compare.h"
+#include "pvr/reference/progressive_reference.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 
@@ -462,6 +464,29 @@ TEST(GpuBackend, MicrofacetMaterialsAndTheSkyMatchTheCpu) {
                                {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory,
                                 DensityKernel::CellSorted},
                                std::string(" ") + stereoModeName(stereo));
+  }
+}
+
+// The converged reference is the same on both backends: the same passes (radii and seeds) give
+// the same average (box filter and a shadow ray to every light included): the two differ far less
+// than either's estimated error, and estimate the same error.
+TEST(GpuBackend, ProgressiveReferenceMatchesTheCpu) {
+  PVR_REQUIRE_GPU();
+  for (const char* name : {"cornell", "cornell-caustics"}) {
+    BothBackends both(name, 96, 104);
+    RenderOptions o = comparisonOptions();
+    o.gather.punctualShadowRays = 0;
+    o.gather.samplesPerPixel = 2;
+    ProgressiveReference cpu(both.cpu, both.rig, o), gpu(both.gpu, both.rig, o);
+    for (int i = 0; i < 12; ++i) cpu.addPass(), gpu.addPass();
+    for (Eye eye : {Eye::Left, Eye::Right}) {
+      const Image a = cpu.image(eye), b = gpu.image(eye);
+      EXPECT_LT(relativeDifference(a.pixels, b.pixels), 0.01) << name;
+      const ReferenceError e = compareToReference(b, a);
+      EXPECT_NEAR(e.meanRatio, 1.0, 0.005) << name;
+      EXPECT_LT(e.relMse, 0.25 * cpu.estimatedRelMse(eye)) << name << ": the same passes, not merely as converged";
+      EXPECT_NEAR(gpu.estimatedRelMse(eye), cpu.estimatedRelMse(eye), 0.05 * cpu.estimatedRelMse(eye)) << name;
+    }
   }
 }
 

@@ -8,6 +8,7 @@
 #include <new>
 #include <memory>
 #include <regex>
+#include <chrono>
 #include <csignal>
 #include <fstream>
 #include <optional>
@@ -20,7 +21,9 @@
 #include "pvr/app/loop_commands.h"
 #include "pvr/app/trajectory.h"
 #include "map_bench.h"
+#include "pvr/image/image_compare.h"
 #include "pvr/image/image_io.h"
+#include "pvr/reference/progressive_reference.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
@@ -106,7 +109,8 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     throw Error("settings file '" + path + "' is not valid JSON: " + std::string(e.what()).substr(0, 120));
   }
   if (!j.is_object()) throw Error("settings file '" + path + "' must hold a JSON object");
-  auto given = [&](const char* flag) { return cmd.count(flag) > 0; };
+  // An option the command does not have (the reference has no --foveated) counts as not given.
+  auto given = [&](const char* flag) { return cmd.get_option_no_throw(flag) != nullptr && cmd.count(flag) > 0; };
   try {
     auto text = [&](const char* key, const char* flag, std::string& field) {
       if (j.contains(key) && !given(flag)) field = j[key].is_string() ? j[key].get<std::string>() : j[key].dump();
@@ -175,8 +179,8 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--seed", a.seed, "Seed of the counter-based random numbers")->capture_default_str();
   cmd.add_option("--photon-depth", a.photonDepth, "Maximum surface interactions per photon path")->capture_default_str();
   cmd.add_option("--shadow-rays", a.shadowRays,
-                 "Shadow rays to the point/spot/sun lights per shaded point, each to one light chosen by its "
-                 "unoccluded contribution (unbiased); 0: one exact ray to every light")
+                 "Shadow rays to the point and spot lights per shaded point, each to one light chosen by its "
+                 "unoccluded contribution (unbiased); suns always get one ray each; 0: one exact ray to every light")
       ->capture_default_str();
 }
 
@@ -377,6 +381,98 @@ int runRender(const RenderArgs& a) {
   return 0;
 }
 
+struct ReferenceArgs {
+  int passes = 256;
+  double seconds = 0;  // 0: no time limit
+  float alpha = 0.7f;
+  std::string filter = "box";
+  int frame = -1;  // a --trajectory frame's view
+  std::string compare;  // EXR images PREFIX_left/right.exr to compare with the reference
+};
+
+// The converged reference of one view, written as linear EXR (and PNG) with a JSON of how far it
+// got; optionally the error of other images against it.
+int runReference(const RenderArgs& a, const ReferenceArgs& r) {
+  if (r.passes < 1 || r.passes > kMaxReferencePasses)
+    throw Error("--passes must be between 1 and " + std::to_string(kMaxReferencePasses) + ", got " + std::to_string(r.passes));
+  if (!(r.seconds >= 0.0) || !std::isfinite(r.seconds)) throw Error("--seconds must be a non-negative number of seconds");
+  if (!(r.alpha > 0.0f && r.alpha < 1.0f)) throw Error("--alpha must be between 0 and 1 (exclusive)");
+  if (r.filter != "box" && r.filter != "centre") throw Error("--filter must be box or centre, got '" + r.filter + "'");
+  if (r.frame >= 0 && a.trajectory.empty()) throw Error("--frame is for --trajectory");
+  RenderArgs full = a;  // every pixel of each eye on its own: a settings file's foveation and TAA do not apply
+  full.foveated = full.taa = false;
+  full.mask.clear();
+  full.taaBlend.clear();
+  std::unique_ptr<RenderSetup> setup = setUpRender(full);
+  StereoRig& rig = setup->rig;
+  if (!setup->trajectory.empty()) {
+    const int frame = std::max(r.frame, 0);
+    if (size_t(frame) >= setup->trajectory.size())
+      throw Error("--frame " + std::to_string(frame) + " is past the trajectory's " + std::to_string(setup->trajectory.size()) + " frames");
+    rig.head = setup->trajectory[size_t(frame)].head;
+  }
+  ensureParentDirectory(a.out);
+  std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(setup->backend, setup->scene);
+  ReferenceSettings settings;
+  settings.alpha = r.alpha;
+  settings.boxFilter = r.filter == "box";
+  const RenderOptions& options = setup->options;
+  ProgressiveReference reference(*renderer, rig, options, settings);
+  std::printf("reference of %s on %s (%s): %dx%d per eye, %u photons and %d spp per pass, radius %g shrinking with alpha %g, %s filter\n",
+              setup->scene.name.c_str(), renderer->name().c_str(), renderer->deviceName().c_str(), rig.width, rig.height,
+              options.photonCount(), options.gather.samplesPerPixel, options.gather.density.radius, r.alpha, r.filter.c_str());
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const Eye reported = options.eyes[0] ? Eye::Left : Eye::Right;
+  int nextReport = 1;
+  while (reference.passes() < r.passes && (r.seconds == 0.0 || elapsed() < r.seconds)) {
+    reference.addPass();
+    if (reference.passes() == nextReport || reference.passes() == r.passes) {
+      std::printf("  pass %6d: radius %.4g, %.1f s, estimated relMSE %.3g\n", reference.passes(),
+                  reference.radiusOfPass(reference.passes() - 1), elapsed(), reference.estimatedRelMse(reported));
+      std::fflush(stdout);
+      nextReport *= 2;
+    }
+  }
+  const char* names[2] = {"left", "right"};
+  nlohmann::json j;
+  j["scene"] = setup->scene.name;
+  j["backend"] = renderer->name();
+  j["device"] = renderer->deviceName();
+  j["eye_size"] = {rig.width, rig.height};
+  j["photons_per_pass"] = options.photonCount();
+  j["spp_per_pass"] = options.gather.samplesPerPixel;
+  j["first_radius"] = options.gather.density.radius;
+  j["last_radius"] = reference.radiusOfPass(reference.passes() - 1);
+  j["alpha"] = r.alpha;
+  j["filter"] = r.filter;
+  j["passes"] = reference.passes();
+  j["seconds"] = elapsed();
+  j["frame_ms"] = reference.frameMs();
+  j["head"] = {{"position", {rig.head.position.x, rig.head.position.y, rig.head.position.z}},
+               {"orientation", {rig.head.orientation.x, rig.head.orientation.y, rig.head.orientation.z, rig.head.orientation.w}}};
+  for (int e = 0; e < 2; ++e) {
+    if (!options.eyes[e]) continue;
+    const Image image = reference.image(Eye(e));
+    for (const char* ext : {".exr", ".png"}) writeImage(image, a.out + "_" + names[e] + ext, a.exposure);
+    const double estimated = reference.estimatedRelMse(Eye(e));
+    j[names[e]]["estimated_rel_mse"] = std::isfinite(estimated) ? nlohmann::json(estimated) : nlohmann::json(nullptr);
+    std::printf("wrote %s_%s.exr/.png: %d passes, estimated relMSE %.3g (variance; the radius' bias falls faster)\n",
+                a.out.c_str(), names[e], reference.passes(), estimated);
+    if (!r.compare.empty()) {
+      const std::string path = r.compare + "_" + names[e] + ".exr";
+      const ReferenceError err = compareToReference(readExr(path), image, {}, a.exposure);
+      j[names[e]]["compared"] = {{"file", path}, {"rel_mse", err.relMse}, {"psnr", err.psnr}, {"ssim", err.ssim},
+                                 {"mean_ratio", err.meanRatio}};
+      std::printf("  %s against it: relMSE %.4g, PSNR %.2f dB, SSIM %.4f, mean %.4f of the reference's\n", path.c_str(),
+                  err.relMse, err.psnr, err.ssim, err.meanRatio);
+    }
+  }
+  std::ofstream(a.out + ".json") << j.dump(2) << "\n";
+  std::printf("wrote %s.json\n", a.out.c_str());
+  return 0;
+}
+
 struct MaskArgs {
   std::string scene = "cornell";
   std::string eyeSize;
@@ -463,6 +559,36 @@ int runCli(int argc, char** argv) {
   render->add_option("--settings", ra.settings,
                      "Settings file (JSON, written by `photonvr view` with F12): options, head pose and gaze; flags given here win");
 
+  RenderArgs fa0;
+  ReferenceArgs rfa;
+  fa0.out = "out/reference";
+  fa0.photons = "1024x1024";
+  fa0.spp = 4;
+  fa0.shadowRays = 0;
+  CLI::App* referenceCmd = app.add_subcommand(
+      "reference", "Render one view to convergence: progressive photon mapping (Knaus-Zwicker: passes with a shrinking "
+                   "radius, averaged) with many samples per pixel; linear EXR, PNG and a JSON of the passes and the estimated error");
+  referenceCmd->add_option("scene", fa0.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
+  addRenderOptions(*referenceCmd, fa0);
+  referenceCmd->add_option("--eyes", fa0.eyes, "Eyes to render: left | right | both")->capture_default_str();
+  referenceCmd->add_option("--eye-size", fa0.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
+  referenceCmd->add_option("--ipd", fa0.ipd, "Interpupillary distance in metres (default: the scene's rig, 0.063)");
+  referenceCmd->add_option("--spp", fa0.spp, "Samples per pixel per pass")->capture_default_str();
+  referenceCmd->add_option("--specular-depth", fa0.specularDepth, "Mirror/glass bounces followed from the eye")->capture_default_str();
+  referenceCmd->add_option("--shading", fa0.shading, "full | photons (the photon map alone)")->capture_default_str();
+  referenceCmd->add_option("--exposure", fa0.exposure, "Scale applied before the sRGB PNG's clamp")->capture_default_str();
+  referenceCmd->add_option("--trajectory", fa0.trajectory, "Trajectory file whose --frame gives the view");
+  referenceCmd->add_option("--frame", rfa.frame, "The trajectory's frame (from 0) to render");
+  referenceCmd->add_option("--settings", fa0.settings, "Settings file (JSON) from `photonvr view`: options and the head pose");
+  referenceCmd->add_option("--passes", rfa.passes, "Passes (independent frames) to average")->capture_default_str();
+  referenceCmd->add_option("--seconds", rfa.seconds, "Stop after this many seconds even if passes remain (0: no limit)")
+      ->capture_default_str();
+  referenceCmd->add_option("--alpha", rfa.alpha, "Radius reduction: r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1)")->capture_default_str();
+  referenceCmd->add_option("--filter", rfa.filter, "Pixel filter: box (samples over the pixel) | centre (as the real-time image)")
+      ->capture_default_str();
+  referenceCmd->add_option("--compare", rfa.compare, "Prefix of images PREFIX_left/right.exr to compare against the reference");
+  referenceCmd->add_option("--out", fa0.out, "Output prefix: PREFIX_left/right.exr/.png and PREFIX.json")->capture_default_str();
+
   // xr and view: the same rendering options, and the loop's.
   RenderArgs xa, va;
   LoopCommandArgs xl, vl;
@@ -540,6 +666,9 @@ int runCli(int argc, char** argv) {
   bench->add_option("--rays-scenes", fa.raysScene, "Scenes of the rays suite")->capture_default_str();
   bench->add_option("--scenes", fa.scenes, "Scenes of the scenes suite (absent meshes are skipped)")->capture_default_str();
   bench->add_option("--scene-radius", fa.sceneRadius, "Search radius of the scenes suite, scene units")->capture_default_str();
+  bench->add_option("--reference-passes", fa.referencePasses,
+                    "Passes of the scenes suite's converged reference (1024x1024 photons each)")
+      ->capture_default_str();
   bench->add_option("--photons", ba.photons, "Comma-separated photon grids (maps suite)")->capture_default_str();
   bench->add_option("--radii", ba.radii, "Comma-separated search radii (maps suite)")->capture_default_str();
   bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye (maps suite)")
@@ -565,6 +694,10 @@ int runCli(int argc, char** argv) {
   try {
     app.parse(argc, argv);
     if (maskCmd->parsed()) return runMask(ma);
+    if (referenceCmd->parsed()) {
+      if (!fa0.settings.empty()) applySettings(fa0.settings, fa0, *referenceCmd);
+      return runReference(fa0, rfa);
+    }
     if (render->parsed()) {
       if (!ra.settings.empty()) applySettings(ra.settings, ra, *render);
       return runRender(ra);

@@ -21,4 +21,23 @@ struct ImageComparison {
 ImageComparison compareDisplayed(const Image& test, const Image& reference, const std::vector<uint8_t>& mask = {},
                                  float exposure = 1.0f);
 
+// Error against a converged reference, the figures the rendering literature reports.
+struct ReferenceError {
+  // Relative MSE in linear radiance: mean over pixels and channels of (x - y)^2 / (y^2 + 0.01)
+  // (Rousselle et al.'s regularised form: dark pixels do not dominate). Exposure-independent up
+  // to the regulariser.
+  double relMse = 0;
+  double psnr = 0;  ///< of the displayed (sRGB-encoded, clamped) images, peak 1
+  // Mean structural similarity (Wang et al. 2004) of the displayed luminance: 11x11 Gaussian
+  // window (sigma 1.5), K1 = 0.01, K2 = 0.03; 1 for identical images.
+  double ssim = 0;
+  double meanRatio = 0;  ///< mean linear luminance of test / of reference (bias: 1 is unbiased)
+  size_t pixels = 0;
+};
+
+// Compares `test` with `reference` (masked as compareDisplayed; SSIM's windows are centred on
+// masked-in pixels). Throws pvr::Error if the sizes differ.
+ReferenceError compareToReference(const Image& test, const Image& reference, const std::vector<uint8_t>& mask = {},
+                                  float exposure = 1.0f);
+
 }  // namespace pvr

@@ -40,6 +40,28 @@ void writeExr(const Image& image, const std::string& path) {
   }
 }
 
+Image readExr(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw Error("cannot read '" + path + "': no such file");
+  try {
+    Imf::RgbaInputFile file(path.c_str());
+    const Imath::Box2i window = file.dataWindow();
+    const long width = long(window.max.x) - window.min.x + 1, height = long(window.max.y) - window.min.y + 1;
+    if (width <= 0 || height <= 0 || width > 65536 || height > 65536 || width * height > (1l << 28))
+      throw Error("cannot read '" + path + "': unsupported image size " + std::to_string(width) + "x" + std::to_string(height));
+    std::vector<Imf::Rgba> rgba(size_t(width) * size_t(height));
+    file.setFrameBuffer(rgba.data() - window.min.x - window.min.y * width, 1, size_t(width));
+    file.readPixels(window.min.y, window.max.y);
+    Image image{static_cast<int>(width), static_cast<int>(height)};
+    for (size_t i = 0; i < rgba.size(); ++i) image.pixels[i] = Vec3(float(rgba[i].r), float(rgba[i].g), float(rgba[i].b));
+    return image;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    std::string what = e.what();
+    throw Error("cannot read '" + path + "' as EXR: " + what.substr(0, what.find('\n')));
+  }
+}
+
 void writeImage(const Image& image, const std::string& path, float exposure) {
   std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".png") writePng(image, path, exposure);

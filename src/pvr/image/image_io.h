@@ -14,6 +14,9 @@ void writePng(const Image& image, const std::string& path, float exposure = 1.0f
 // 8-bit RGB rows as they are (a display image read back), written as `writePng` writes its bytes.
 void writePngRgb(const std::vector<unsigned char>& rgb, int width, int height, const std::string& path);
 void writeExr(const Image& image, const std::string& path);
+// Reads an EXR's RGB (linear; as writeExr writes them). Throws pvr::Error naming the file if it is
+// missing, not an EXR, or of an unsupported size.
+Image readExr(const std::string& path);
 // Writes PNG or EXR by the path's extension (.png, .exr).
 void writeImage(const Image& image, const std::string& path, float exposure = 1.0f);
 

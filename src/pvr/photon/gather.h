@@ -23,9 +23,11 @@ struct GatherParams {
   ShadingMode mode = ShadingMode::Full;
   int maxSpecularDepth = 8;  ///< mirror/glass bounces followed from the eye
   int samplesPerPixel = 1;
-  // Shadow rays to the punctual lights per gather point, each to one light chosen by its
-  // unoccluded contribution (punctualDirectLight); 0: one exact ray to every light.
+  // Shadow rays to the point and spot lights per gather point, each to one light chosen by its
+  // unoccluded contribution (punctualDirectLight; distant lights get a ray each); 0: one exact
+  // ray to every light.
   int punctualShadowRays = 1;
+  bool jitterFirstSample = false;  ///< false: sample 0 through the pixel centre (a stable first hit)
   uint32_t seed = 1;
 };
 
@@ -88,29 +90,36 @@ PVR_HOST_DEVICE ShadowedContribution punctualContribution(const SceneView& scene
   return c;
 }
 
-// Direct light from the point, spot and distant lights at a surface point. With shadowRays == 0,
-// or at least one ray per light, every light gets one exact shadow ray. Otherwise each of the
-// shadowRays rays goes to one light chosen in proportion to the luminance of its unoccluded
-// contribution here (its power and solid angle, the cosine and the BSDF): unbiased, and exact in
-// luminance wherever every light is visible, so the noise is the visibility's and the lights' hues. The choice is one
-// weighted-reservoir pass over the lights with one random number, so nothing is stored per light.
+// Direct light from the point, spot and distant lights at a surface point. Each distant light
+// (the sun) gets one exact shadow ray: it dominates where it shines and is hidden wholesale where
+// it does not (a nave under a roof), which a choice made without visibility would sample as often
+// either way. Among the point and spot lights, each of the shadowRays rays goes to one light chosen
+// in proportion to the luminance of its unoccluded contribution here (its power and solid angle,
+// the cosine and the BSDF): unbiased, and exact in luminance wherever those lights are visible, so
+// the noise is their visibility's and their hues'. With shadowRays == 0, or at least one ray per
+// light, every light gets one exact ray. The choice is one weighted-reservoir pass over the lights
+// with one random number, so nothing is stored per light.
 template <class Intersector, class Bsdf>
 PVR_HOST_DEVICE Vec3 punctualDirectLight(const SceneView& scene, const Intersector& intersector, Vec3 position,
                                          Vec3 nGeo, Vec3 nShade, bool twoSided, float eps, const Bsdf& bsdf,
                                          int shadowRays, CounterRng& rng) {
   Vec3 sum{0, 0, 0};
-  if (shadowRays <= 0 || uint32_t(shadowRays) >= scene.punctualCount) {
-    for (uint32_t k = 0; k < scene.punctualCount; ++k) {
-      ShadowedContribution c = punctualContribution(scene, k, position, nGeo, nShade, twoSided, eps, bsdf);
-      if (!isBlack(c.value) && !intersector.occluded(c.shadow, c.distance)) sum += c.value;
-    }
-    return sum;
+  uint32_t localCount = 0;
+  for (uint32_t k = 0; k < scene.punctualCount; ++k) localCount += scene.punctualLights[k].kind != PunctualKind::Directional;
+  const bool chooseLocal = shadowRays > 0 && uint32_t(shadowRays) < localCount;
+  for (uint32_t k = 0; k < scene.punctualCount; ++k) {
+    if (chooseLocal && scene.punctualLights[k].kind != PunctualKind::Directional) continue;
+    ShadowedContribution c = punctualContribution(scene, k, position, nGeo, nShade, twoSided, eps, bsdf);
+    if (!isBlack(c.value) && !intersector.occluded(c.shadow, c.distance)) sum += c.value;
   }
+  if (!chooseLocal) return sum;
+  Vec3 chosenSum{0, 0, 0};
   for (int s = 0; s < shadowRays; ++s) {
     float u = rng.uniform();
     float total = 0.0f, chosenWeight = 0.0f;
     ShadowedContribution chosen;
     for (uint32_t k = 0; k < scene.punctualCount; ++k) {
+      if (scene.punctualLights[k].kind == PunctualKind::Directional) continue;
       ShadowedContribution c = punctualContribution(scene, k, position, nGeo, nShade, twoSided, eps, bsdf);
       float w = luminance(c.value);
       if (!(w > 0.0f)) continue;
@@ -124,9 +133,9 @@ PVR_HOST_DEVICE Vec3 punctualDirectLight(const SceneView& scene, const Intersect
       }
     }
     if (chosenWeight > 0.0f && !intersector.occluded(chosen.shadow, chosen.distance))
-      sum += chosen.value * (total / chosenWeight);
+      chosenSum += chosen.value * (total / chosenWeight);
   }
-  return sum * (1.0f / float(shadowRays));
+  return sum + chosenSum * (1.0f / float(shadowRays));
 }
 
 // One sample of the area lights' direct light at a surface point (front side only).
@@ -278,11 +287,15 @@ PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, Eye eye, 
 }
 
 // The camera ray of sample s of pixel (x, y), with the random numbers that continue its path. The
-// first sample goes through the pixel centre, so the first-hit id is stable.
+// first sample goes through the pixel centre, so the first-hit id is stable, unless
+// params.jitterFirstSample (a reference's box filter).
 PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
                                           int s, CounterRng& rng) {
   rng = pixelRng(params, eye, uint32_t(y) * uint32_t(camera.width) + uint32_t(x), s);
-  float jx = s == 0 ? 0.5f : rng.uniform(), jy = s == 0 ? 0.5f : rng.uniform();
+  const bool centre = s == 0 && !params.jitterFirstSample;
+  // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+  float jx = centre ? 0.5f : rng.uniform();
+  float jy = centre ? 0.5f : rng.uniform();
   return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 

@@ -150,6 +150,9 @@ PVR_HOST_DEVICE inline void neighbourhoodRange(const TaaView& v, int x, int y, V
     }
 }
 
+// Reprojected positions this close to a pixel centre read that pixel exactly.
+constexpr float kTaaSnapPixels = 2e-3f;
+
 // The displayed colour of pixel (x, y); `usedHistory` says whether the history contributed
 // (false: first frame, disocclusion, or the point was off the previous image).
 PVR_HOST_DEVICE inline Vec3 resolveTemporalPixel(const TaaView& v, int x, int y, bool& usedHistory) {
@@ -161,6 +164,11 @@ PVR_HOST_DEVICE inline Vec3 resolveTemporalPixel(const TaaView& v, int x, int y,
   if (!reprojectToPrevious(v, x, y, px, py, expected) ||
       !previousSawSameSurface(v, px, py, expected, sampleStep(v, x, y)))
     return current;
+  // A still head reprojects onto the pixel centres up to float rounding (about 1e-4 pixel); read
+  // those pixels as they are, or Catmull-Rom mixes a rounding's worth of the neighbours in every
+  // frame and the history settles off the image by that much times 1 / blend (at a light's edge).
+  const float snappedX = floorf(px) + 0.5f, snappedY = floorf(py) + 0.5f;
+  if (fabsf(px - snappedX) < kTaaSnapPixels && fabsf(py - snappedY) < kTaaSnapPixels) px = snappedX, py = snappedY;
   Vec3 history = sampleCatmullRom(v.history, v.previousCamera.width, v.previousCamera.height, px, py);
   if (v.params.clampToNeighbourhood) {
     Vec3 lo, hi;
