@@ -184,6 +184,23 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
       ->capture_default_str();
 }
 
+// What the commands that write images of a view (render, reference) share: the scene, the render
+// options, the eyes and rig, samples, shading and exposure.
+void addImageCommandOptions(CLI::App& cmd, RenderArgs& a, const char* sppHelp) {
+  cmd.add_option("scene", a.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
+  addRenderOptions(cmd, a);
+  cmd.add_option("--eyes", a.eyes, "Eyes to render: left | right | both")->capture_default_str();
+  cmd.add_option("--eye-size", a.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
+  cmd.add_option("--ipd", a.ipd, "Interpupillary distance in metres (default: the scene's rig, 0.063)");
+  cmd.add_option("--spp", a.spp, sppHelp)->capture_default_str();
+  cmd.add_option("--specular-depth", a.specularDepth, "Mirror/glass bounces followed from the eye")->capture_default_str();
+  cmd.add_option("--shading", a.shading,
+                 "full (direct light by shadow rays + photon map for caustics/indirect) | photons (photon map "
+                 "alone, the paper's formulation)")
+      ->capture_default_str();
+  cmd.add_option("--exposure", a.exposure, "Scale applied before the sRGB PNG's clamp")->capture_default_str();
+}
+
 // The render options from their spellings: syntax here, ranges in validateOptions (one place).
 RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   RenderOptions o;
@@ -526,19 +543,7 @@ int runCli(int argc, char** argv) {
       "OBJ/MTL Kd, Ks/Ns (glossy), mirrors (illum 3) and glass (illum 4-9), alpha MASK / map_d cut-outs, bump maps;\n"
       "point, spot and directional lights (KHR_lights_punctual) and a sky (JSON scenes).\n"
       "Defaults render the Cornell box at 1440x1600 per eye with 256x256 photons in a few seconds on 2 cores.");
-  render->add_option("scene", ra.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
-  addRenderOptions(*render, ra);
-  render->add_option("--eyes", ra.eyes, "Eyes to render: left | right | both")->capture_default_str();
-  render->add_option("--eye-size", ra.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
-  render->add_option("--ipd", ra.ipd, "Interpupillary distance in metres (default: the scene's rig, 0.063)");
-  render->add_option("--spp", ra.spp, "Samples per pixel")->capture_default_str();
-  render->add_option("--specular-depth", ra.specularDepth, "Mirror/glass bounces followed from the eye")
-      ->capture_default_str();
-  render->add_option("--shading", ra.shading,
-                     "full (direct light by shadow rays + photon map for caustics/indirect) | photons (photon map "
-                     "alone, the paper's formulation)")
-      ->capture_default_str();
-  render->add_option("--exposure", ra.exposure, "Scale applied before the sRGB PNG's clamp")->capture_default_str();
+  addImageCommandOptions(*render, ra, "Samples per pixel");
   render->add_flag("--foveated", ra.foveated,
                    "Foveated: shade only a foveation mask's vertices around the gaze and reconstruct");
   render->add_option("--mask", ra.mask, "Foveation mask file from `photonvr mask` (default: made for the rig at start)");
@@ -559,27 +564,19 @@ int runCli(int argc, char** argv) {
   render->add_option("--settings", ra.settings,
                      "Settings file (JSON, written by `photonvr view` with F12): options, head pose and gaze; flags given here win");
 
-  RenderArgs fa0;
+  RenderArgs referenceArgs;
   ReferenceArgs rfa;
-  fa0.out = "out/reference";
-  fa0.photons = "1024x1024";
-  fa0.spp = 4;
-  fa0.shadowRays = 0;
+  referenceArgs.out = "out/reference";
+  referenceArgs.photons = "1024x1024";
+  referenceArgs.spp = 4;
+  referenceArgs.shadowRays = 0;
   CLI::App* referenceCmd = app.add_subcommand(
       "reference", "Render one view to convergence: progressive photon mapping (Knaus-Zwicker: passes with a shrinking "
                    "radius, averaged) with many samples per pixel; linear EXR, PNG and a JSON of the passes and the estimated error");
-  referenceCmd->add_option("scene", fa0.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
-  addRenderOptions(*referenceCmd, fa0);
-  referenceCmd->add_option("--eyes", fa0.eyes, "Eyes to render: left | right | both")->capture_default_str();
-  referenceCmd->add_option("--eye-size", fa0.eyeSize, "Per-eye resolution WxH (default: the scene's rig, 1440x1600)");
-  referenceCmd->add_option("--ipd", fa0.ipd, "Interpupillary distance in metres (default: the scene's rig, 0.063)");
-  referenceCmd->add_option("--spp", fa0.spp, "Samples per pixel per pass")->capture_default_str();
-  referenceCmd->add_option("--specular-depth", fa0.specularDepth, "Mirror/glass bounces followed from the eye")->capture_default_str();
-  referenceCmd->add_option("--shading", fa0.shading, "full | photons (the photon map alone)")->capture_default_str();
-  referenceCmd->add_option("--exposure", fa0.exposure, "Scale applied before the sRGB PNG's clamp")->capture_default_str();
-  referenceCmd->add_option("--trajectory", fa0.trajectory, "Trajectory file whose --frame gives the view");
+  addImageCommandOptions(*referenceCmd, referenceArgs, "Samples per pixel per pass");
+  referenceCmd->add_option("--trajectory", referenceArgs.trajectory, "Trajectory file whose --frame gives the view");
   referenceCmd->add_option("--frame", rfa.frame, "The trajectory's frame (from 0) to render");
-  referenceCmd->add_option("--settings", fa0.settings, "Settings file (JSON) from `photonvr view`: options and the head pose");
+  referenceCmd->add_option("--settings", referenceArgs.settings, "Settings file (JSON) from `photonvr view`: options and the head pose");
   referenceCmd->add_option("--passes", rfa.passes, "Passes (independent frames) to average")->capture_default_str();
   referenceCmd->add_option("--seconds", rfa.seconds, "Stop after this many seconds even if passes remain (0: no limit)")
       ->capture_default_str();
@@ -587,7 +584,7 @@ int runCli(int argc, char** argv) {
   referenceCmd->add_option("--filter", rfa.filter, "Pixel filter: box (samples over the pixel) | centre (as the real-time image)")
       ->capture_default_str();
   referenceCmd->add_option("--compare", rfa.compare, "Prefix of images PREFIX_left/right.exr to compare against the reference");
-  referenceCmd->add_option("--out", fa0.out, "Output prefix: PREFIX_left/right.exr/.png and PREFIX.json")->capture_default_str();
+  referenceCmd->add_option("--out", referenceArgs.out, "Output prefix: PREFIX_left/right.exr/.png and PREFIX.json")->capture_default_str();
 
   // xr and view: the same rendering options, and the loop's.
   RenderArgs xa, va;
@@ -695,8 +692,8 @@ int runCli(int argc, char** argv) {
     app.parse(argc, argv);
     if (maskCmd->parsed()) return runMask(ma);
     if (referenceCmd->parsed()) {
-      if (!fa0.settings.empty()) applySettings(fa0.settings, fa0, *referenceCmd);
-      return runReference(fa0, rfa);
+      if (!referenceArgs.settings.empty()) applySettings(referenceArgs.settings, referenceArgs, *referenceCmd);
+      return runReference(referenceArgs, rfa);
     }
     if (render->parsed()) {
       if (!ra.settings.empty()) applySettings(ra.settings, ra, *render);

@@ -93,7 +93,7 @@ ReferenceError compareToReference(const Image& test, const Image& reference, con
     if (!mask.empty() && !mask[i]) continue;
     for (int c = 0; c < 3; ++c) {
       double x = double(test.pixels[i][c]) * exposure, y = double(reference.pixels[i][c]) * exposure;
-      relative += (x - y) * (x - y) / (y * y + 0.01);
+      relative += (x - y) * (x - y) / (y * y + kRelMseRegulariser);
     }
     testSum += luminance(test.pixels[i]);
     referenceSum += luminance(reference.pixels[i]);

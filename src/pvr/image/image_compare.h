@@ -21,6 +21,9 @@ struct ImageComparison {
 ImageComparison compareDisplayed(const Image& test, const Image& reference, const std::vector<uint8_t>& mask = {},
                                  float exposure = 1.0f);
 
+// The relative MSE's regulariser: (x - y)^2 / (y^2 + kRelMseRegulariser).
+constexpr double kRelMseRegulariser = 0.01;
+
 // Error against a converged reference, the figures the rendering literature reports.
 struct ReferenceError {
   // Relative MSE in linear radiance: mean over pixels and channels of (x - y)^2 / (y^2 + 0.01)

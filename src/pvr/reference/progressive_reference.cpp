@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "pvr/image/image_compare.h"
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
 #include "pvr/util/rng.h"
@@ -76,7 +77,7 @@ double ProgressiveReference::estimatedRelMse(Eye eye, const std::vector<uint8_t>
     ++counted;
     double mean = sum_[e][i] / n;
     double variance = std::max(sumSquares_[e][i] / n - mean * mean, 0.0) * n / (n - 1.0);
-    total += variance / n / (mean * mean + 0.01);
+    total += variance / n / (mean * mean + kRelMseRegulariser);
   }
   return counted ? total / double(counted) : 0.0;
 }
