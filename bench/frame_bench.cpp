@@ -18,6 +18,7 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "bench_util.h"
+#include "quality_bench.h"
 #include "pvr/util/latency_stats.h"
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
@@ -864,8 +865,8 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
 
 int runFrameBench(const FrameBenchArgs& args) {
   if (args.suite != "tables" && args.suite != "rays" && args.suite != "grid" && args.suite != "stereo" &&
-      args.suite != "foveation" && args.suite != "scenes" && args.suite != "all")
-    throw Error("--suite must be tables, stereo, foveation, scenes, rays, grid or all, got '" + args.suite + "'");
+      args.suite != "foveation" && args.suite != "scenes" && args.suite != "quality" && args.suite != "all")
+    throw Error("--suite must be tables, stereo, foveation, scenes, quality, rays, grid or all, got '" + args.suite + "'");
   if (!(args.sceneRadius > 0.0f) || !std::isfinite(args.sceneRadius)) throw Error("--scene-radius must be a positive number");
   if (args.frames < 1 || args.frames > 100000) throw Error("--frames must be between 1 and 100000");
   if (args.warmup < 0 || args.warmup > 100000) throw Error("--warmup must be between 0 and 100000");
@@ -887,6 +888,7 @@ int runFrameBench(const FrameBenchArgs& args) {
     if (args.suite == "foveation" || args.suite == "all") failures += runFoveation(args, scene, *renderer, rig, json);
   }
   if (args.suite == "scenes") failures += runScenes(args, kind, json);
+  if (args.suite == "quality") failures += runQuality(args, kind, json);
 #ifdef PVR_HAVE_CUDA
   if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json);
   if (args.suite == "grid" || args.suite == "all") failures += runGrid(args, json);

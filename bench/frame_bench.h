@@ -9,7 +9,8 @@
 //    paper's; gather, ours), with the right eye's reuse fraction, cost and image quality;
 //  - foveation: foveated against full-resolution frames, and the temporal flicker with and without TAA;
 //  - scenes: textured scenes (Dabrovic Sponza, Sibenik) with full shading: separate and gather
-//    frames, the cost of texture sampling, and each image's error against 16x the photons.
+//    frames, the cost of texture sampling, and each image's error against a converged reference;
+//  - quality: raw, TAA and denoised frames against converged references (quality_bench.h).
 // Every suite checks its own results and says which GPU, resolution, photons and radius it ran.
 // Timings are tail latencies (one slow frame drops a frame in the headset): every frame cell keeps
 // each timed frame's wall time and stage times and reports their mean, p50, p99 and max
@@ -29,7 +30,9 @@ struct FrameBenchArgs {
   std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
   std::string scenes = "scenes/dabrovic-sponza.json,scenes/sibenik.json,cornell-dense";  ///< scenes suite (cornell-dense: the per-ray yardstick); absent meshes: skipped
   float sceneRadius = 0.15f;  ///< scenes suite: the search radius, scene units
-  int referencePasses = 64;   ///< scenes suite: passes of the progressive reference (1024x1024 photons each)
+  int referencePasses = 64;   ///< scenes and quality suites: passes of the progressive reference (1024x1024 photons each)
+  std::string qualityScenes = "cornell,scenes/dabrovic-sponza.json";  ///< quality suite
+  std::string qualityImages;  ///< quality suite: PNG prefix (empty: none)
   int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)
   int warmup = 10;
   int k = 32;

@@ -65,6 +65,13 @@ expect_error "--taa-blend: the TAA blend must be in (0, 1\]" render cornell --ta
 expect_error "--taa-blend: the TAA blend must be in (0, 1\]" render cornell --taa --taa-blend 1.5 --eye-size 8x8
 expect_error "--taa-blend" render cornell --taa --taa-blend nan --eye-size 8x8
 expect_error "--taa-blend" render cornell --taa --taa-blend 0.5x --eye-size 8x8
+expect_error "--denoise-iterations is for --denoise" render cornell --denoise-iterations 3 --eye-size 8x8
+expect_error "--no-refine is for --denoise" render cornell --no-refine --eye-size 8x8
+expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations 9 --eye-size 8x8
+expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations -1 --eye-size 8x8
+expect_error "--denoise-iterations" render cornell --denoise --denoise-iterations two --eye-size 8x8
+expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty
+expect_error "--reference-passes must be between 2" bench --suite quality --reference-passes 1 --backend cpu
 expect_error "--suite must be" bench --suite speed
 expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -32,19 +33,24 @@ class RecordingBackend : public FrameBackend {
            (pass.foveated() ? " foveated" : ""));
   }
   float inverseDepthAt(Eye eye, size_t) override { return record(eye == Eye::Left ? "depth left" : "depth right"), 0.0f; }
-  void resolveTemporal(Eye eye, const EyeCamera&, const TaaParams&, bool) override {
-    record(eye == Eye::Left ? "taa left" : "taa right");
+  void denoise(const EyePass& pass, const DenoiseParams&) override {
+    record(pass.eye == Eye::Left ? "denoise left" : "denoise right");
+  }
+  void resolveTemporal(Eye eye, const EyeCamera&, const TaaParams&, bool, bool denoised) override {
+    record(std::string(eye == Eye::Left ? "taa left" : "taa right") + (denoised ? " of denoised" : ""));
   }
   void forgetHistory(Eye eye) override { record(eye == Eye::Left ? "forget left" : "forget right"); }
+  void forgetDenoiseHistory(Eye) override {}
   FrameCounters finishFrame() override { return record("finish"), FrameCounters(); }
   void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override {
     record(std::string("read ") + (eye == Eye::Left ? "left" : "right"));
     if (what.firstPrim) out.firstPrim.emplace();
     if (what.sampleSpacing) out.sampleSpacing.emplace();
     if (what.reusedFrom) out.reusedFrom.emplace();
-    displayed[int(eye)] = what.displayed;
+    displayed[int(eye)] = what.image == EyeImage::Displayed;
+    denoised[int(eye)] = what.image == EyeImage::Denoised;
   }
-  bool displayed[2] = {false, false};
+  bool displayed[2] = {false, false}, denoised[2] = {false, false};
 
  private:
   void record(const std::string& call) { calls.push_back(call); }
@@ -79,6 +85,17 @@ TEST(FramePipeline, RunsTheStagesInOneOrder) {
   EXPECT_EQ(joined(r.calls), "trace, build, eye left source, taa left, scatter, eye right reuser, taa right, finish, "
                              "read left, read right");
   EXPECT_TRUE(r.displayed[0] && r.displayed[1]);
+
+  r.calls.clear();
+  o.denoise.enabled = true;
+  renderer.render(tinyRig(), o);
+  EXPECT_EQ(joined(r.calls), "trace, build, eye left source, denoise left, taa left of denoised, scatter, eye right reuser, "
+                             "denoise right, taa right of denoised, finish, read left, read right");
+  o.temporal.enabled = false;
+  r.calls.clear();
+  renderer.render(tinyRig(), o);
+  EXPECT_TRUE(r.denoised[0] && r.denoised[1]);
+  o.denoise.enabled = false;
 
   r.calls.clear();
   FoveationMask mask = generateFoveationMask(maskParamsForRig(tinyRig()));
@@ -139,9 +156,34 @@ TEST(FramePipeline, AStageThatReadsWhatNoStageWroteIsAnError) {
   flow.run(eyePassIO(right));
   EXPECT_TRUE(flow.has(FrameData::ReusedFrom, 1));
   EXPECT_FALSE(flow.has(FrameData::DisplayedImage, 1));
-  EXPECT_THROW(flow.run(temporalIO(Eye::Right, true)), Error) << "a full-resolution eye has no sample spacing";
-  flow.run(temporalIO(Eye::Right, false));
+  EXPECT_THROW(flow.run(temporalIO(Eye::Right, true, false)), Error) << "a full-resolution eye has no sample spacing";
+  EXPECT_THROW(flow.run(temporalIO(Eye::Right, false, true)), Error) << "nothing denoised the right eye";
+  EXPECT_THROW(flow.run(denoiseIO(right)), Error) << "the eye passes wrote no denoise guides";
+  flow.run(temporalIO(Eye::Right, false, false));
   EXPECT_TRUE(flow.has(FrameData::DisplayedImage, 1));
+}
+
+// The right eye's denoise under reuse reads the left eye's denoised image: the left must be
+// denoised first.
+TEST(FramePipeline, TheReusersDenoiseReadsTheLeftEyesDenoisedImage) {
+  FrameDataflow flow;
+  flow.run(photonTraceIO());
+  flow.run(mapBuildIO());
+  EyePass left, right;
+  left.role = StereoRole::Source, left.denoiseGuides = true;
+  right.eye = Eye::Right, right.role = StereoRole::Reuser, right.reuse = StereoMode::Gather, right.denoiseGuides = true;
+  flow.run(eyePassIO(left));
+  flow.run(eyePassIO(right));
+  EXPECT_TRUE(flow.has(FrameData::DenoiseGuides, 0) && flow.has(FrameData::DenoiseGuides, 1));
+  try {
+    flow.run(denoiseIO(right));
+    FAIL() << "the right eye's denoise ran before the left's";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("denoised image of the left eye"), std::string::npos) << e.what();
+  }
+  flow.run(denoiseIO(left));
+  flow.run(denoiseIO(right));
+  EXPECT_TRUE(flow.has(FrameData::DenoisedImage, 1));
 }
 
 // The CPU backend's timings: each eye's time is the sum of its stages, and only stages that ran count.
@@ -185,6 +227,10 @@ TEST(FrameOptions, ErrorsNameTheOptionAndTheCommandLineItsFlag) {
       {RenderOption::Gaze, [](RenderOptions& o, StereoRig&) { o.foveation.gaze[1][0] = 1.5f; }, "--gaze"},
       {RenderOption::TaaBlend, [](RenderOptions& o, StereoRig&) { o.temporal.enabled = true, o.temporal.taa.blend = 0; }, "--taa-blend"},
       {RenderOption::Stereo, [](RenderOptions& o, StereoRig&) { o.stereo = StereoMode::Gather, o.eyes[1] = false; }, "--stereo"},
+      {RenderOption::DenoiseIterations, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.iterations = 9; }, "--denoise-iterations"},
+      {RenderOption::DenoiseParameter, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.colourAlpha = 0; }, "--denoise"},
+      {RenderOption::DenoiseParameter, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.depthTolerance = NAN; }, "--denoise"},
+      {RenderOption::DenoiseParameter, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.refineAlpha = 1; }, "--denoise"},
   };
   EXPECT_NO_THROW(validateOptions(RenderOptions(), rig));
   for (const Case& c : cases) {

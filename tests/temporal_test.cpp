@@ -68,6 +68,7 @@ TEST(Temporal, ReprojectionRoundTrips) {
 // the clamp never moves history away from it, and each frame keeps (1 - blend) of the error.
 void expectConvergence(FrameRenderer& renderer, const StereoRig& rig, RenderOptions first, RenderOptions still) {
   renderer.resetHistory();
+  renderer.setFreshNoisePerFrame(false);  // every frame the same numbers: TAA's own convergence
   still.temporal.enabled = first.temporal.enabled = false;
   FrameResult target = renderer.render(rig, still);
   still.temporal.enabled = first.temporal.enabled = true;
@@ -220,10 +221,26 @@ TEST(Temporal, ClampingStopsGhosts) {
   EXPECT_LT(ghostClamped, 0.4);
 }
 
+// While TAA blends frames each frame draws new random numbers, so that the blend averages noise;
+// frames that blend nothing, or a renderer told not to, draw the seed's.
+TEST(Temporal, BlendedFramesDrawNewNoiseEachFrame) {
+  Scene scene = builtinScene("cornell");
+  StereoRig rig = smallRig(scene);
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  RenderOptions o = smallOptions();
+  EXPECT_EQ(maxDifference(renderer.render(rig, o).eyes[0].image, renderer.render(rig, o).eyes[0].image), 0.0f);
+  o.temporal.enabled = true;
+  o.temporal.taa.blend = 1.0f;  // shows the current frame
+  EXPECT_GT(maxDifference(renderer.render(rig, o).eyes[0].image, renderer.render(rig, o).eyes[0].image), 0.01f);
+  renderer.setFreshNoisePerFrame(false);  // the same frame again (up to the blend's rounding)
+  EXPECT_LT(maxDifference(renderer.render(rig, o).eyes[0].image, renderer.render(rig, o).eyes[0].image), 1e-5f);
+}
+
 TEST(Temporal, ResetAndNewEyeSizeStartFromTheRenderedFrame) {
   Scene scene = builtinScene("cornell");
   StereoRig rig = smallRig(scene);
   FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  renderer.setFreshNoisePerFrame(false);  // the TAA frame after the reset is the plain frame exactly
   RenderOptions o = smallOptions();
   RenderOptions other = o;
   other.gather.seed = 5;

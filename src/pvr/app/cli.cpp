@@ -90,6 +90,9 @@ struct RenderArgs {
   std::string trajectory;    // one frame per line: head pose + gaze
   bool taa = false;
   std::string taaBlend;      // empty: TaaParams' default
+  bool denoise = false;
+  int denoiseIterations = DenoiseParams().iterations;
+  bool noRefine = false;
   std::string out = "out/render";
   float exposure = 1.0f;
   std::string acuity = "linear";  // the mask made at start under --foveated
@@ -132,6 +135,9 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     text("taa_blend", "--taa-blend", a.taaBlend);
     flag("foveated", "--foveated", a.foveated);
     flag("taa", "--taa", a.taa);
+    flag("denoise", "--denoise", a.denoise);
+    if (j.contains("denoise_iterations") && !given("--denoise-iterations"))
+      a.denoiseIterations = j["denoise_iterations"].get<int>();
     if (j.contains("k") && !given("--k")) a.k = j["k"].get<int>();
     if (j.contains("exposure") && !given("--exposure")) a.exposure = j["exposure"].get<float>();
     if (j.contains("scene") && !given("scene")) a.scene = j["scene"].get<std::string>();
@@ -186,6 +192,19 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
 
 // What the commands that write images of a view (render, reference) share: the scene, the render
 // options, the eyes and rig, samples, shading and exposure.
+// The denoiser's options (render, xr, view).
+void addDenoiseOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_flag("--denoise", a.denoise,
+               "Spatio-temporal denoising (SVGF) before TAA: direct and photon-map light demodulated by albedo, "
+               "accumulated over frames by reprojection, filtered by an edge-aware a-trous wavelet");
+  cmd.add_option("--denoise-iterations", a.denoiseIterations,
+                 "A-trous passes of --denoise (0: temporal accumulation only; at most 8)")
+      ->capture_default_str();
+  cmd.add_flag("--no-refine", a.noRefine,
+               "With --denoise: no progressive refinement while the head is still (averaging still frames with a "
+               "shrinking photon radius)");
+}
+
 void addImageCommandOptions(CLI::App& cmd, RenderArgs& a, const char* sppHelp) {
   cmd.add_option("scene", a.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
   addRenderOptions(cmd, a);
@@ -292,6 +311,12 @@ std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
     options.temporal.enabled = true;
     if (!a.taaBlend.empty()) options.temporal.taa.blend = parseFloat(a.taaBlend, "--taa-blend");
   }
+  if (a.denoiseIterations != DenoiseParams().iterations && !a.denoise)
+    throw Error("--denoise-iterations is for --denoise");
+  if (a.noRefine && !a.denoise) throw Error("--no-refine is for --denoise");
+  options.denoise.params.refineWhenStill = !a.noRefine;
+  options.denoise.enabled = a.denoise;
+  options.denoise.params.iterations = a.denoiseIterations;
   validateOptions(options, rig);  // all of them, before any work
   if (!a.trajectory.empty()) setup->trajectory = loadTrajectory(a.trajectory);
   if (scene.skippedTriangles() > 0)
@@ -556,6 +581,7 @@ int runCli(int argc, char** argv) {
                    "Temporal anti-aliasing across --trajectory frames: reprojection by depth and head motion, "
                    "neighbourhood clamping, reset on disocclusion");
   render->add_option("--taa-blend", ra.taaBlend, "Weight of the current frame under --taa, in (0, 1] (default 0.1)");
+  addDenoiseOptions(*render, ra);
   render->add_option("--out", ra.out, "Output prefix: writes PREFIX_left.png/.exr and PREFIX_right.png/.exr")
       ->capture_default_str();
 
@@ -611,6 +637,7 @@ int runCli(int argc, char** argv) {
     cmd->add_option("--gaze", a->gaze, "Gaze X,Y (image fractions) when no eye tracker gives one")->capture_default_str();
     cmd->add_flag("--taa", a->taa, "Temporal anti-aliasing across the loop's frames");
     cmd->add_option("--taa-blend", a->taaBlend, "Weight of the current frame under --taa, in (0, 1]");
+    addDenoiseOptions(*cmd, *a);
     cmd->add_option("--settings", a->settings, "Settings file (JSON) from `photonvr view`; flags given here win");
   }
   xr->add_option("--frames", xl.frames, "Frames to render, then end the session cleanly (0: until the runtime ends it or Ctrl-C)")
@@ -645,7 +672,8 @@ int runCli(int argc, char** argv) {
                "CUDA ray throughput (rays), GPU hash-grid build (grid), CPU photon-map queries (maps)");
   bench->add_option("scene", ba.scene, "Scene for the tables, grid and maps suites")->capture_default_str();
   bench->add_option("--suite", fa.suite,
-                    "tables | rays | grid | stereo | foveation | scenes (textured scenes, full shading) | all (tables, "
+                    "tables | rays | grid | stereo | foveation | scenes (textured scenes, full shading) | quality (raw, "
+                    "TAA and denoised frames against converged references, moving and still head) | all (tables, "
                     "stereo, rays, grid) | maps (CPU map queries)")
       ->capture_default_str();
   bench->add_option("--stereo", fa.stereo, "Table 5's columns: separate, scatter, gather (stereo suite)")
@@ -664,8 +692,12 @@ int runCli(int argc, char** argv) {
   bench->add_option("--scenes", fa.scenes, "Scenes of the scenes suite (absent meshes are skipped)")->capture_default_str();
   bench->add_option("--scene-radius", fa.sceneRadius, "Search radius of the scenes suite, scene units")->capture_default_str();
   bench->add_option("--reference-passes", fa.referencePasses,
-                    "Passes of the scenes suite's converged reference (1024x1024 photons each)")
+                    "Passes of the scenes and quality suites' converged references (1024x1024 photons each)")
       ->capture_default_str();
+  bench->add_option("--quality-scenes", fa.qualityScenes, "Scenes of the quality suite (absent meshes are skipped)")
+      ->capture_default_str();
+  bench->add_option("--quality-images", fa.qualityImages,
+                    "Quality suite: write PNGs (the left eye's central 480x480) of a sampled frame of each variant and its reference to PREFIX_*.png");
   bench->add_option("--photons", ba.photons, "Comma-separated photon grids (maps suite)")->capture_default_str();
   bench->add_option("--radii", ba.radii, "Comma-separated search radii (maps suite)")->capture_default_str();
   bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye (maps suite)")

@@ -66,7 +66,8 @@ nlohmann::json describeRun(const Renderer& renderer, const LoopSetup& setup, con
           {"stereo", stereoModeName(o.stereo)},
           {"kernel", densityKernelName(o.kernel)},
           {"foveated", o.foveation.mask != nullptr},
-          {"taa", o.temporal.enabled}};
+          {"taa", o.temporal.enabled},
+          {"denoise", o.denoise.enabled}};
 }
 
 // A mask for the rig's size when foveated and the size changed (the headset chose it).
@@ -238,6 +239,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
   vs.acuity = args.acuity == "geisler-perry";
   vs.taa = o.temporal.enabled;
   vs.taaBlend = o.temporal.taa.blend;
+  vs.denoise = o.denoise.enabled;
   vs.exposure = args.exposure;
   vs.bothEyes = o.eyes[1];
   BackendKind kind = setup.backend;
@@ -269,6 +271,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                         {"foveated", s.foveated},
                         {"acuity", s.acuity ? "geisler-perry" : "linear"},
                         {"taa", s.taa},
+                        {"denoise", s.denoise},
                         {"exposure", s.exposure},
                         {"eye_size", std::to_string(rig0.width) + "x" + std::to_string(rig0.height)},
                         {"gaze", gaze},

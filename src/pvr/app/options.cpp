@@ -41,6 +41,8 @@ const char* flagOf(RenderOption option) {
     case RenderOption::TaaBlend: return "--taa-blend";
     case RenderOption::TaaDepthTolerance: return "--taa-depth-tolerance";
     case RenderOption::Stereo: return "--stereo";
+    case RenderOption::DenoiseIterations: return "--denoise-iterations";
+    case RenderOption::DenoiseParameter: return "--denoise";
   }
   return "--?";
 }

@@ -28,26 +28,30 @@ std::vector<Photon> CpuBackend::tracePhotons(const PhotonTraceParams& params) co
 
 template <class Map>
 void CpuBackend::renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                               PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const {
+                               PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces,
+                               PixelGuide* guides) const {
   SceneView view = scene_.view();
   // 16x16 tiles: coherent rays per task and good load balance.
   parallelForTiles("eye pass", camera.height, camera.width, 16, [&](int y0, int y1, int x0, int x1) {
     for (int y = y0; y < y1; ++y)
       for (int x = x0; x < x1; ++x) {
         size_t pixel = size_t(y) * camera.width + x;
-        out[pixel] = shadePixel(view, intersector_, map, params, camera, eye, x, y, reuse, surfaces ? surfaces + pixel : nullptr);
+        out[pixel] = shadePixel(view, intersector_, map, params, camera, eye, x, y, reuse,
+                                surfaces ? surfaces + pixel : nullptr, guides ? guides + pixel : nullptr);
       }
   });
 }
 
 void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
-                           PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const {
-  renderEyeWith(camera, eye, params, map, out, reuse, surfaces);
+                           PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces,
+                           PixelGuide* guides) const {
+  renderEyeWith(camera, eye, params, map, out, reuse, surfaces, guides);
 }
 
 void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
-                           PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const {
-  renderEyeWith(camera, eye, params, map, out, reuse, surfaces);
+                           PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces,
+                           PixelGuide* guides) const {
+  renderEyeWith(camera, eye, params, map, out, reuse, surfaces, guides);
 }
 
 template <class Map>

@@ -22,13 +22,14 @@ class CpuBackend {
 
   // Shades every pixel of one eye into `out` (width * height entries, row-major, top row first),
   // taking the other eye's shading where `reuse` allows, and recording each pixel's surface in
-  // `surfaces` if given (the eye the other one reuses).
+  // `surfaces` if given (the eye the other one reuses), and what the denoiser needs in `guides`
+  // if given.
   void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
                  PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
-                 SurfaceRecord* surfaces = nullptr) const;
+                 SurfaceRecord* surfaces = nullptr, PixelGuide* guides = nullptr) const;
   void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
                  PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
-                 SurfaceRecord* surfaces = nullptr) const;
+                 SurfaceRecord* surfaces = nullptr, PixelGuide* guides = nullptr) const;
 
   // Foveated: shades the mask's vertices in use for the gaze pixel (gazeX, gazeY) into
   // `colours` and `inverseDepths` (one per mask vertex; unused ones untouched); returns the
@@ -59,7 +60,8 @@ class CpuBackend {
                                SurfaceRecord* surfaces, size_t* reused) const;
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
-                     PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces) const;
+                     PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces,
+                     PixelGuide* guides) const;
   const Scene& scene_;
   EmbreeIntersector intersector_;
 };

@@ -71,9 +71,18 @@ void CpuFrameBackend::renderEyeWith(const EyePass& pass, const Map& map) {
     return;
   }
   samples_.assign(pixels, PixelSample());
+  if (pass.denoiseGuides) guides_.assign(pixels, PixelGuide());
   {
     StageScope scope(clock_, Stage::EyeRays, e);  // one fused pass, like the single kernel
-    backend_.renderEye(camera, pass.eye, pass.gather, map, samples_.data(), reuse, surfaces);
+    backend_.renderEye(camera, pass.eye, pass.gather, map, samples_.data(), reuse, surfaces,
+                       pass.denoiseGuides ? guides_.data() : nullptr);
+  }
+  if (pass.denoiseGuides) {
+    out.emitted.resize(pixels), out.direct.resize(pixels), out.albedo.resize(pixels), out.normal.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      const PixelGuide& g = guides_[i];
+      out.emitted[i] = g.emitted, out.direct[i] = g.direct, out.albedo[i] = g.albedo, out.normal[i] = g.normal;
+    }
   }
   counters_.shadedSamples[e] = pixels;
   out.rendered = Image(camera.width, camera.height);
@@ -98,9 +107,31 @@ void CpuFrameBackend::renderEye(const EyePass& pass) {
   else renderEyeWith(pass, tree_.view());
 }
 
-void CpuFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) {
+void CpuFrameBackend::denoise(const EyePass& pass, const DenoiseParams& params) {
+  EyeBuffers& b = eyes_[int(pass.eye)];
+  DenoiseInputs in;
+  in.image = b.rendered.pixels.data();
+  in.inverseDepth = b.inverseDepth.data();
+  if (pass.foveated()) {
+    in.sampleSpacing = b.sampleSpacing.data();
+  } else {
+    in.emitted = b.emitted.data(), in.direct = b.direct.data(), in.albedo = b.albedo.data(), in.normal = b.normal.data();
+    if (pass.role == StereoRole::Reuser) {
+      const EyeBuffers& left = eyes_[int(Eye::Left)];
+      in.reusedFrom = b.reusedFrom.data();
+      in.sourceImage = left.rendered.pixels.data();
+      in.sourceEmitted = left.emitted.data(), in.sourceDirect = left.direct.data();
+      in.sourceAlbedo = left.albedo.data(), in.sourceNormal = left.normal.data();
+      in.sourceDenoised = left.denoised.pixels.data();
+    }
+  }
+  denoiser_.denoise(pass.eye, pass.camera, params, in, b.denoised, pass.stillFrames);
+}
+
+void CpuFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated,
+                                      bool denoised) {
   EyeBuffers& b = eyes_[int(eye)];
-  counters_.historyPixels[int(eye)] = pvr::resolveTemporal(camera, params, b.rendered, b.inverseDepth,
+  counters_.historyPixels[int(eye)] = pvr::resolveTemporal(camera, params, denoised ? b.denoised : b.rendered, b.inverseDepth,
                                                            foveated ? b.sampleSpacing.data() : nullptr,
                                                            history_[int(eye)], b.displayed);
 }
@@ -113,7 +144,9 @@ FrameCounters CpuFrameBackend::finishFrame() {
 
 void CpuFrameBackend::readEye(Eye eye, const EyeReadback& what, EyeResult& out) {
   EyeBuffers& b = eyes_[int(eye)];  // the frame is over: its buffers move out
-  out.image = std::move(what.displayed ? b.displayed : b.rendered);
+  out.image = std::move(what.image == EyeImage::Displayed  ? b.displayed
+                        : what.image == EyeImage::Denoised ? b.denoised
+                                                           : b.rendered);
   out.inverseDepth = std::move(b.inverseDepth);
   if (what.firstPrim) out.firstPrim = std::move(b.firstPrim);
   if (what.sampleSpacing) out.sampleSpacing = std::move(b.sampleSpacing);

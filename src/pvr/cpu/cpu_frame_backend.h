@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "pvr/cpu/cpu_backend.h"
+#include "pvr/denoise/host_denoiser.h"
 #include "pvr/pipeline/frame_renderer.h"
 #include "pvr/temporal/taa_history.h"
 
@@ -22,8 +23,10 @@ class CpuFrameBackend : public FrameBackend {
   void scatter(const EyeCamera& source, const EyeCamera& target) override;
   void renderEye(const EyePass& pass) override;
   float inverseDepthAt(Eye eye, size_t pixel) override { return eyes_[int(eye)].inverseDepth.at(pixel); }
-  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) override;
+  void denoise(const EyePass& pass, const DenoiseParams& params) override;
+  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated, bool denoised) override;
   void forgetHistory(Eye eye) override { history_[int(eye)].valid = false; }
+  void forgetDenoiseHistory(Eye eye) override { denoiser_.forget(eye); }
   FrameCounters finishFrame() override;
   void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override;
 
@@ -32,9 +35,10 @@ class CpuFrameBackend : public FrameBackend {
  private:
   // One eye's buffers between its stages.
   struct EyeBuffers {
-    Image rendered, displayed;
+    Image rendered, denoised, displayed;
     std::vector<float> inverseDepth, sampleSpacing;
     std::vector<uint32_t> firstPrim, reusedFrom;
+    std::vector<Vec3> emitted, direct, albedo, normal;  ///< the denoiser's guides (full resolution)
   };
   template <class Map>
   void renderEyeWith(const EyePass& pass, const Map& map);
@@ -48,8 +52,10 @@ class CpuFrameBackend : public FrameBackend {
   std::vector<SurfaceRecord> sourceSurfaces_;
   std::vector<uint64_t> scattered_;
   std::vector<PixelSample> samples_;
+  std::vector<PixelGuide> guides_;
   EyeBuffers eyes_[2];
   TaaHistory history_[2];
+  HostDenoiser denoiser_;
   FrameCounters counters_;
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "pvr/cuda/cuda_stage_clock.h"
+#include "pvr/cuda/denoise.cuh"
 #include "pvr/cuda/eye_pass.cuh"
 #include "pvr/cuda/photon_map_build.cuh"
 #include "pvr/cuda/photon_trace.cuh"
@@ -37,6 +38,7 @@ struct CudaFrameBackend::Impl {
   HashGridView gridView;
   KdTreeView treeView;
   cuda::GpuEyePass eyePass;
+  cuda::GpuDenoiser denoiser;
   cuda::GpuTemporal temporal;
   std::unique_ptr<cuda::CudaStageClock> clock;
   cuda::EventTimer benchTimer;
@@ -161,14 +163,39 @@ float CudaFrameBackend::inverseDepthAt(Eye eye, size_t pixel) {
   return value;
 }
 
-void CudaFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) {
+void CudaFrameBackend::denoise(const EyePass& pass, const DenoiseParams& params) {
+  Impl& m = *impl_;
+  const Eye eye = pass.eye;
+  DenoiseInputs in;
+  in.image = m.eyePass.image(eye);
+  in.inverseDepth = m.eyePass.inverseDepth(eye);
+  if (pass.foveated()) {
+    in.sampleSpacing = m.eyePass.sampleSpacing(eye);
+  } else {
+    in.emitted = m.eyePass.emitted(eye), in.direct = m.eyePass.direct(eye);
+    in.albedo = m.eyePass.albedo(eye), in.normal = m.eyePass.normal(eye);
+    if (pass.role == StereoRole::Reuser) {
+      in.reusedFrom = m.eyePass.reusedFrom();
+      in.sourceImage = m.eyePass.image(Eye::Left);
+      in.sourceEmitted = m.eyePass.emitted(Eye::Left), in.sourceDirect = m.eyePass.direct(Eye::Left);
+      in.sourceAlbedo = m.eyePass.albedo(Eye::Left);
+      in.sourceNormal = m.eyePass.normal(Eye::Left);
+      in.sourceDenoised = m.denoiser.image(Eye::Left);
+    }
+  }
+  m.denoiser.denoise(eye, pass.camera, params, in, pass.stillFrames, m.stream);
+}
+
+void CudaFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated,
+                                       bool denoised) {
   Impl& m = *impl_;
   m.frame.temporal = true;
-  m.temporal.resolve(eye, camera, params, m.eyePass.image(eye), m.eyePass.inverseDepth(eye),
-                     foveated ? m.eyePass.sampleSpacing(eye) : nullptr, m.stream);
+  m.temporal.resolve(eye, camera, params, denoised ? m.denoiser.image(eye) : m.eyePass.image(eye),
+                     m.eyePass.inverseDepth(eye), foveated ? m.eyePass.sampleSpacing(eye) : nullptr, m.stream);
 }
 
 void CudaFrameBackend::forgetHistory(Eye eye) { impl_->temporal.forget(eye); }
+void CudaFrameBackend::forgetDenoiseHistory(Eye eye) { impl_->denoiser.forget(eye); }
 
 FrameCounters CudaFrameBackend::finishFrame() {
   Impl& m = *impl_;
@@ -196,7 +223,7 @@ void CudaFrameBackend::readEye(Eye eye, const EyeReadback& what, EyeResult& out)
     PVR_CUDA_CHECK(cudaMemcpyAsync(host, device, n * sizeof(*host), cudaMemcpyDeviceToHost, m.stream));
   };
   out.image = Image(m.frame.width[int(eye)], m.frame.height[int(eye)]);
-  download(out.image.pixels.data(), what.displayed ? m.temporal.image(eye) : m.eyePass.image(eye), pixels);
+  download(out.image.pixels.data(), deviceImage(eye, what.image), pixels);
   out.inverseDepth.resize(pixels);
   download(out.inverseDepth.data(), m.eyePass.inverseDepth(eye), pixels);
   if (what.sampleSpacing) {
@@ -214,8 +241,13 @@ void CudaFrameBackend::readEye(Eye eye, const EyeReadback& what, EyeResult& out)
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
 }
 
-const Vec3* CudaFrameBackend::deviceImage(Eye eye, bool displayed) const {
-  return displayed ? impl_->temporal.image(eye) : impl_->eyePass.image(eye);
+const Vec3* CudaFrameBackend::deviceImage(Eye eye, EyeImage which) const {
+  switch (which) {
+    case EyeImage::Displayed: return impl_->temporal.image(eye);
+    case EyeImage::Denoised: return impl_->denoiser.image(eye);
+    case EyeImage::Rendered: break;
+  }
+  return impl_->eyePass.image(eye);
 }
 
 const float* CudaFrameBackend::deviceInverseDepth(Eye eye) const { return impl_->eyePass.inverseDepth(eye); }

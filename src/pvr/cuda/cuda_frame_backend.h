@@ -41,11 +41,13 @@ class CudaFrameBackend : public FrameBackend {
   void scatter(const EyeCamera& source, const EyeCamera& target) override;
   void renderEye(const EyePass& pass) override;
   float inverseDepthAt(Eye eye, size_t pixel) override;
-  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) override;
+  void denoise(const EyePass& pass, const DenoiseParams& params) override;
+  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated, bool denoised) override;
   void forgetHistory(Eye eye) override;
+  void forgetDenoiseHistory(Eye eye) override;
   FrameCounters finishFrame() override;
   void readEye(Eye eye, const EyeReadback& what, EyeResult& out) override;
-  const Vec3* deviceImage(Eye eye, bool displayed) const override;
+  const Vec3* deviceImage(Eye eye, EyeImage which) const override;
   const float* deviceInverseDepth(Eye eye) const override;
   void* deviceStream() const override;
 

@@ -33,6 +33,17 @@ __device__ inline void recordPixel(const EyeOutputs& out, size_t pixel, const Pi
   countInWarp(out.reusedCount, p.reusedFrom != kNotReused);
 }
 
+// The denoiser's guides of one sample's gather point: the emitted and direct parts summed like
+// the image, albedo and normal from sample 0.
+__device__ inline void recordGuide(const EyeOutputs& out, size_t pixel, const GatherPoint& p, int sample, int samples) {
+  if (!out.direct) return;
+  storeSample(out.emitted, pixel, p.emitted, sample, samples);
+  storeSample(out.direct, pixel, p.radiance, sample, samples);
+  if (sample > 0) return;
+  out.albedo[pixel] = p.demodulationAlbedo();
+  out.normal[pixel] = p.normal;
+}
+
 // An eye's part in stereo reuse (pvr::StereoRole) is a compile-time kernel parameter: the reuse
 // code paths cost registers, so an eye that does not reuse gets kernels without them.
 template <StereoRole R>

@@ -17,10 +17,15 @@ __global__ void singleKernel(SceneView scene, BvhIntersector sceneIntersector, M
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   params.density.estimator = E;  // compile-time estimator: the radius kernel carries no heap
   size_t pixel = size_t(y) * camera.width + x;
+  PixelGuide guide;
   PixelSample s = shadePixel(scene, intersector, map, params, camera, eye, x, y, reuseFor<R>(reuse),
-                             surfaceFor<R>(out, pixel));
+                             surfaceFor<R>(out, pixel), out.direct ? &guide : nullptr);
   out.image[pixel] = s.radiance;
   recordPixel(out, pixel, s);
+  if (out.direct) {
+    out.emitted[pixel] = guide.emitted, out.direct[pixel] = guide.direct;
+    out.albedo[pixel] = guide.albedo, out.normal[pixel] = guide.normal;
+  }
 }
 
 // Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
@@ -33,8 +38,10 @@ __global__ void eyeRaysKernel(SceneView scene, BvhIntersector sceneIntersector, 
   size_t pixel = size_t(y) * camera.width + x;
   PixelSample state;
   if (R == StereoRole::Reuser && sample > 0) state.reusedFrom = out.reusedFrom[pixel];  // sample 0 decided
-  points.store(pixel, pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuseFor<R>(reuse), state,
-                                   surfaceFor<R>(out, pixel)));
+  const GatherPoint point = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuseFor<R>(reuse),
+                                            state, surfaceFor<R>(out, pixel));
+  points.store(pixel, point);
+  recordGuide(out, pixel, point, sample, params.samplesPerPixel);
   if (sample == 0) recordPixel(out, pixel, state);
 }
 
@@ -88,7 +95,7 @@ size_t GpuEyePass::memoryBytes() const {
                  vertexInverseDepths_.bytes();
   for (int i = 0; i < 2; ++i)
     bytes += images_[i].bytes() + firstPrim_[i].bytes() + inverseDepth_[i].bytes() + sampleSpacing_[i].bytes() +
-             sortKeys_[i].bytes() + sortValues_[i].bytes();
+             sortKeys_[i].bytes() + sortValues_[i].bytes() + emitted_[i].bytes() + direct_[i].bytes() + albedo_[i].bytes() + normal_[i].bytes();
   return bytes;
 }
 
@@ -109,6 +116,12 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
   out.image = image;
   out.firstPrim = (firstPrim_[e].reserve(pixels, "first-hit ids"), firstPrim_[e].data());
   out.inverseDepth = (inverseDepth_[e].reserve(pixels, "eye depths"), inverseDepth_[e].data());
+  if (pass.denoiseGuides) {
+    out.emitted = (emitted_[e].reserve(pixels, "denoiser emitted light"), emitted_[e].data());
+    out.direct = (direct_[e].reserve(pixels, "denoiser direct light"), direct_[e].data());
+    out.albedo = (albedo_[e].reserve(pixels, "denoiser albedo"), albedo_[e].data());
+    out.normal = (normal_[e].reserve(pixels, "denoiser normals"), normal_[e].data());
+  }
   StereoReuseView reuse = prepareReuse(pass, stream, out);
 
   if (pass.kernel == DensityKernel::Single) {  // shadePixel loops over the samples itself

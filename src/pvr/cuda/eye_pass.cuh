@@ -23,6 +23,11 @@ struct EyeOutputs {
   SurfaceRecord* surfaces = nullptr;  ///< the left eye under stereo reuse
   uint32_t* reusedFrom = nullptr;     ///< the right eye under stereo reuse
   unsigned* reusedCount = nullptr;    ///< with reusedFrom: pixels that took the left eye's shading
+  // The denoiser's guides (pvr::PixelGuide), all four or none.
+  Vec3* emitted = nullptr;
+  Vec3* direct = nullptr;
+  Vec3* albedo = nullptr;
+  Vec3* normal = nullptr;
 };
 
 // Gather points on the device in two arrays: what every point has, and the BSDF of microfacet
@@ -101,6 +106,11 @@ class GpuEyePass {
   const float* inverseDepth(Eye e) const { return inverseDepth_[int(e)].data(); }
   const float* sampleSpacing(Eye e) const { return sampleSpacing_[int(e)].data(); }  ///< foveated only
   const uint32_t* reusedFrom() const { return reusedFrom_.data(); }
+  // The denoiser's guides of the last full-resolution pass of an eye that wrote them.
+  const Vec3* emitted(Eye e) const { return emitted_[int(e)].data(); }
+  const Vec3* direct(Eye e) const { return direct_[int(e)].data(); }
+  const Vec3* albedo(Eye e) const { return albedo_[int(e)].data(); }
+  const Vec3* normal(Eye e) const { return normal_[int(e)].data(); }
   // The right eye's reused-sample count, copied to the host when the stream reaches it.
   void downloadReusedCount(unsigned* host, cudaStream_t stream) const;
   size_t memoryBytes() const;
@@ -113,6 +123,7 @@ class GpuEyePass {
   DeviceBuffer<Vec3> images_[2];
   DeviceBuffer<uint32_t> firstPrim_[2];
   DeviceBuffer<float> inverseDepth_[2], sampleSpacing_[2];
+  DeviceBuffer<Vec3> emitted_[2], direct_[2], albedo_[2], normal_[2];
   DeviceBuffer<SurfaceRecord> surfaces_;
   DeviceBuffer<uint64_t> scattered_;
   DeviceBuffer<uint32_t> reusedFrom_;

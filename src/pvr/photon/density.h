@@ -4,6 +4,8 @@
 // either over all photons within a fixed radius (no heap: the paper's choice) or over the k
 // nearest within a maximum radius, with r the k-th distance (max-heap, radius shrinking).
 // Works on any photon map with `search(q, r2, visitor)`: HashGridView, KdTreeView.
+#include <cmath>
+
 #include "pvr/photon/knn_heap.h"
 #include "pvr/photon/photon.h"
 
@@ -16,6 +18,14 @@ struct DensityParams {
   Estimator estimator = Estimator::Radius;
   int k = 32;  ///< photons for kNN, 1..kMaxKnn
 };
+
+// Knaus and Zwicker's (2011) progressive radius of pass `pass` (from 0): r_{i+1}^2 = r_i^2 (i + alpha)
+// / (i + 1) from r_0 = first, so r_n^2 = first^2 Gamma(n + 1 + alpha) / (Gamma(1 + alpha) Gamma(n + 2)).
+inline float progressiveRadius(float first, int pass, float alpha) {
+  const double n = double(pass);
+  const double r2 = std::exp(std::lgamma(n + 1.0 + alpha) - std::lgamma(1.0 + alpha) - std::lgamma(n + 2.0));
+  return float(double(first) * std::sqrt(r2));
+}
 
 // A photon counts towards a surface only if it arrived from the side the normal faces.
 PVR_HOST_DEVICE inline bool photonFacesSurface(Vec3 photonDirection, Vec3 n) { return dot(photonDirection, n) < 0.0f; }

@@ -50,6 +50,7 @@ struct PixelSample {
 // each photon's direction (view-dependent), and weight is the path's throughput.
 struct GatherPoint {
   Vec3 radiance{0, 0, 0};
+  Vec3 emitted{0, 0, 0};  ///< the part of radiance emitted along the path (lights, sky seen): no noise
   Vec3 weight{0, 0, 0};  ///< zero when the path found no surface to gather on
   Vec3 position{0, 0, 0};
   Vec3 normal{0, 0, 0};  ///< geometric normal facing the arriving ray
@@ -61,6 +62,21 @@ struct GatherPoint {
   PVR_HOST_DEVICE Vec3 photonContribution(const Photon& p) const {
     return lobes == 0 ? p.power : bsdf.eval(wo, -p.direction, lobes) * p.power;
   }
+  // What the denoiser divides the pixel by, so that it filters irradiance rather than texture: the
+  // path's reflectance towards the eye (throughput times albedo; the base colour on a microfacet
+  // surface). Zero where the path found no surface to gather on.
+  PVR_HOST_DEVICE Vec3 demodulationAlbedo() const { return lobes == 0 ? weight * kPi : weight * bsdf.baseColor; }
+};
+
+// What the denoiser needs of a pixel besides its radiance: its emitted part (lights and sky seen,
+// which it leaves alone) and its direct part (emission and shadow rays; the rest came from the
+// photon map), both the mean over its samples, and sample 0's demodulation albedo and
+// gather-surface normal (zero: none).
+struct PixelGuide {
+  Vec3 emitted{0, 0, 0};
+  Vec3 direct{0, 0, 0};
+  Vec3 albedo{0, 0, 0};
+  Vec3 normal{0, 0, 0};
 };
 
 // What a punctual light would add at a surface point if its shadow ray is unblocked.
@@ -193,15 +209,20 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
     if (depth == 0 && firstHit) hit = *firstHit;
     else intersector.intersect(ray, INFINITY, hit);
     if (!hit.valid()) {  // escaped: the sky (never reached this way from a gather point)
-      out.radiance += throughput * scene.sky.along(ray.dir);
+      const Vec3 sky = throughput * scene.sky.along(ray.dir);
+      out.radiance += sky;
+      out.emitted += sky;
       break;
     }
     coneWidth += coneSpread * hit.t;
     SurfacePoint sp = scene.surfacePoint(hit);
     const Material& m = scene.materials[sp.materialId];
     bool front = dot(ray.dir, sp.geometricNormal) < 0.0f;
-    if (front && m.isEmissive())
-      out.radiance += throughput * scene.emissionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, sp.geometricNormal));
+    if (front && m.isEmissive()) {
+      const Vec3 e = throughput * scene.emissionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, sp.geometricNormal));
+      out.radiance += e;
+      out.emitted += e;
+    }
     Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
     if (m.type == MaterialType::Diffuse) {
       Vec3 nShade = front ? sp.shadingNormal : -sp.shadingNormal;
@@ -387,23 +408,37 @@ PVR_HOST_DEVICE GatherPoint vertexGatherPoint(const SceneView& scene, const Inte
 }
 
 // Pixel (x, y) of one eye: the average of samplesPerPixel jittered rays, or the other eye's
-// colour where `reuse` finds the same surface point.
+// colour where `reuse` finds the same surface point. `guideOut`, if given, receives what the
+// denoiser needs (a reused pixel's direct part is its whole colour: the denoiser takes the other
+// eye's guides there).
 template <class Intersector, class PhotonMap>
 PVR_HOST_DEVICE PixelSample shadePixel(const SceneView& scene, const Intersector& intersector, const PhotonMap& map,
                                        const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
                                        const StereoReuseView& reuse = StereoReuseView(),
-                                       SurfaceRecord* surfaceOut = nullptr) {
+                                       SurfaceRecord* surfaceOut = nullptr, PixelGuide* guideOut = nullptr) {
   PixelSample out;
+  PixelGuide guide;
   for (int s = 0; s < params.samplesPerPixel; ++s) {
     GatherPoint point = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, s, reuse, out,
                                          s == 0 ? surfaceOut : nullptr);
     if (out.reusedFrom != kNotReused) {  // the other eye's finished colour
       out.radiance = point.radiance;
+      if (guideOut) guideOut->direct = point.radiance, guideOut->emitted = Vec3(0.0f);
       return out;
+    }
+    if (guideOut) {
+      guide.direct += point.radiance;
+      guide.emitted += point.emitted;
+      if (s == 0) guide.albedo = point.demodulationAlbedo(), guide.normal = point.normal;
     }
     out.radiance += finishGather(map, point, params.density);
   }
   out.radiance *= 1.0f / float(params.samplesPerPixel);
+  if (guideOut) {
+    guide.direct *= 1.0f / float(params.samplesPerPixel);
+    guide.emitted *= 1.0f / float(params.samplesPerPixel);
+    *guideOut = guide;
+  }
   return out;
 }
 

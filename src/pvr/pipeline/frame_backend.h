@@ -11,9 +11,15 @@
 //                  left RenderedImage, (scatter)                full: FirstHits; foveated:
 //                  ScatteredSurfaces                            SampleSpacing; source:
 //                                                               SourceSurfaces; full reuser:
-//                                                               ReusedFrom
-//   temporal       RenderedImage, InverseDepth, (foveated)      DisplayedImage (and the eye's
-//                  SampleSpacing, the eye's history             history)
+//                                                               ReusedFrom; full, denoising:
+//                                                               DenoiseGuides
+//   denoise        RenderedImage, InverseDepth; full:           DenoisedImage (and the eye's
+//                  DenoiseGuides; foveated: SampleSpacing;      history)
+//                  full reuser: ReusedFrom, the left
+//                  DenoiseGuides and DenoisedImage
+//   temporal       RenderedImage (denoised: DenoisedImage),     DisplayedImage (and the eye's
+//                  InverseDepth, (foveated) SampleSpacing,      history)
+//                  the eye's history
 //
 // FrameDataflow checks these declarations while a frame runs: a stage that would read what no
 // earlier stage wrote this frame is an error, and a frame's results hold exactly what was written.
@@ -46,6 +52,8 @@ struct EyePass {
   EyeCamera source;                          ///< the reuser's: the eye it reuses (the left)
   const FoveationMask* mask = nullptr;       ///< foveated: the mask, placed at the gaze pixel
   int gazeX = 0, gazeY = 0;
+  bool denoiseGuides = false;  ///< full resolution: also write what the denoiser needs (direct part, albedo, normal)
+  int stillFrames = 0;         ///< frames the view has been still before this one (the denoiser's refinement)
   bool foveated() const { return mask != nullptr; }
 };
 
@@ -75,6 +83,8 @@ enum class FrameData : int {
   FirstHits,          ///< per pixel, the first triangle hit (full resolution)
   SampleSpacing,      ///< per pixel, the foveated samples' spacing
   ReusedFrom,         ///< per right pixel, the left pixel it took its shading from
+  DenoiseGuides,      ///< per pixel, the denoiser's: direct part, demodulation albedo, normal
+  DenoisedImage,      ///< after the denoiser
   DisplayedImage,     ///< after TAA
   Count,
 };
@@ -94,7 +104,8 @@ StageIO photonTraceIO();
 StageIO mapBuildIO();
 StageIO scatterIO();
 StageIO eyePassIO(const EyePass& pass);
-StageIO temporalIO(Eye eye, bool foveated);
+StageIO denoiseIO(const EyePass& pass);
+StageIO temporalIO(Eye eye, bool foveated, bool denoised);
 
 // What has been written this frame.
 class FrameDataflow {
@@ -111,8 +122,11 @@ class FrameDataflow {
 };
 
 // Which of an eye's outputs to copy out at the end of the frame.
+// The images an eye has in a frame, in the order the stages write them.
+enum class EyeImage : int { Rendered = 0, Denoised = 1, Displayed = 2 };
+
 struct EyeReadback {
-  bool displayed = false;  ///< the TAA image (else the rendered one)
+  EyeImage image = EyeImage::Rendered;  ///< the one the eye is shown
   bool firstPrim = false, sampleSpacing = false, reusedFrom = false;
 };
 
@@ -140,15 +154,21 @@ class FrameBackend {
   virtual void renderEye(const EyePass& pass) = 0;
   // One value of an eye's inverse depth (vergence needs the left eye's at its gaze); may wait.
   virtual float inverseDepthAt(Eye eye, size_t pixel) = 0;
-  // Temporal: blends the eye's rendered image with its history into its displayed image.
-  virtual void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated) = 0;
+  // Denoise: the eye's rendered image, guided by its depth and (full resolution) the pass's
+  // guides, with the eye's denoising history, into its denoised image. Under full-resolution
+  // reuse the right eye's reused pixels show the left eye's denoised colour.
+  virtual void denoise(const EyePass& pass, const DenoiseParams& params) = 0;
+  // Temporal: blends the eye's rendered (or denoised) image with its history into its displayed image.
+  virtual void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated,
+                               bool denoised) = 0;
   virtual void forgetHistory(Eye eye) = 0;  ///< the next resolve starts again
+  virtual void forgetDenoiseHistory(Eye eye) = 0;  ///< the next denoise starts again
   // Waits for the frame's work; the clock's times are valid after this.
   virtual FrameCounters finishFrame() = 0;
   virtual void readEye(Eye eye, const EyeReadback& what, EyeResult& out) = 0;
-  // The eye's image (displayed: after TAA) where it lies in GPU memory: linear RGB, row-major,
-  // valid until the next frame; null for backends that render on the host.
-  virtual const Vec3* deviceImage(Eye eye, bool displayed) const { return nullptr; }
+  // One of the eye's images where it lies in GPU memory: linear RGB, row-major, valid until the
+  // next frame; null for backends that render on the host.
+  virtual const Vec3* deviceImage(Eye eye, EyeImage which) const { return nullptr; }
   // The last frame's per-pixel 1 / view depth of an eye in GPU memory; null on the CPU.
   virtual const float* deviceInverseDepth(Eye eye) const { return nullptr; }
   // The GPU stream the frame's work runs on (cudaStream_t); work queued on it after a frame runs

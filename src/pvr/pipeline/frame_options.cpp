@@ -61,6 +61,24 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
     if (!(t.depthTolerance > 0.0f && t.depthTolerance < 1.0f))
       throw OptionError(RenderOption::TaaDepthTolerance, "the TAA depth tolerance must be in (0, 1)");
   }
+  if (o.denoise.enabled) {
+    const DenoiseParams& d = o.denoise.params;
+    if (d.iterations < 0 || d.iterations > kMaxDenoiseIterations)
+      throw OptionError(RenderOption::DenoiseIterations,
+                        "the denoiser's a-trous passes must be between 0 and " + std::to_string(kMaxDenoiseIterations));
+    if (!(d.colourAlpha > 0.0f && d.colourAlpha <= 1.0f) || !(d.momentsAlpha > 0.0f && d.momentsAlpha <= 1.0f))
+      throw OptionError(RenderOption::DenoiseParameter, "the denoiser's history weights must be in (0, 1]");
+    if (!(d.stillPosition >= 0.0f) || !std::isfinite(d.stillPosition) || !(d.stillAngleDegrees >= 0.0f) ||
+        !std::isfinite(d.stillAngleDegrees) || !(d.refineAlpha > 0.0f && d.refineAlpha < 1.0f) ||
+        !(d.minRadiusFraction > 0.0f && d.minRadiusFraction <= 1.0f))
+      throw OptionError(RenderOption::DenoiseParameter,
+                        "the refinement's tolerances must be non-negative and finite, its alpha in (0, 1) and its "
+                        "least radius fraction in (0, 1]");
+    if (!(d.sigmaLuminance > 0.0f) || !std::isfinite(d.sigmaLuminance) || !(d.normalPower >= 0.0f) ||
+        !std::isfinite(d.normalPower) || !(d.depthTolerance > 0.0f && d.depthTolerance < 1.0f))
+      throw OptionError(RenderOption::DenoiseParameter,
+                        "the denoiser's edge-stopping parameters must be positive and finite (depth tolerance in (0, 1))");
+  }
   if (o.stereo != StereoMode::Separate && !(o.eyes[0] && o.eyes[1]))
     throw OptionError(RenderOption::Stereo, std::string("stereo reuse (") + stereoModeName(o.stereo) +
                                                 ") renders the right eye from the left: it needs both eyes");

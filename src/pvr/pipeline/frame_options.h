@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pvr/camera/stereo_rig.h"
+#include "pvr/denoise/svgf.h"
 #include "pvr/foveation/foveation_options.h"
 #include "pvr/photon/gather.h"
 #include "pvr/photon/photon_map.h"
@@ -34,6 +35,7 @@ struct RenderOptions {
   bool eyes[2] = {true, true};
   StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading
   FoveationOptions foveation;
+  DenoiseOptions denoise;  ///< before TAA, which then resolves the denoised image
   TemporalOptions temporal;
   uint32_t photonCount() const { return photonsX * photonsY; }
   // The photon pass these options ask for (every backend traces the same photons).
@@ -57,7 +59,7 @@ constexpr int kMaxShadowRays = 64;
 // line names its flag).
 enum class RenderOption : int {
   Photons, PhotonDepth, Radius, K, SamplesPerPixel, SpecularDepth, ShadowRays, EyeSize, Ipd, Kernel, Gaze, TaaBlend,
-  TaaDepthTolerance, Stereo,
+  TaaDepthTolerance, Stereo, DenoiseIterations, DenoiseParameter,
 };
 
 class OptionError : public Error {

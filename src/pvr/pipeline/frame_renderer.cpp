@@ -1,6 +1,7 @@
 #include "pvr/pipeline/frame_renderer.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace pvr {
 
@@ -12,6 +13,7 @@ const char* stageName(Stage stage) {
     case Stage::EyeRays: return "eye rays";
     case Stage::Density: return "density estimation";
     case Stage::Reconstruct: return "foveated reconstruction";
+    case Stage::Denoise: return "denoise";
     case Stage::Temporal: return "temporal resolve";
     case Stage::Count: break;
   }
@@ -29,6 +31,8 @@ const char* frameDataName(FrameData data) {
     case FrameData::FirstHits: return "first hits";
     case FrameData::SampleSpacing: return "sample spacing";
     case FrameData::ReusedFrom: return "reuse map";
+    case FrameData::DenoiseGuides: return "denoise guides";
+    case FrameData::DenoisedImage: return "denoised image";
     case FrameData::DisplayedImage: return "displayed image";
     case FrameData::Count: break;
   }
@@ -44,6 +48,7 @@ StageIO eyePassIO(const EyePass& pass) {
   StageIO io{Stage::EyeRays, {{FrameData::PhotonMap}}, {{FrameData::RenderedImage, e}, {FrameData::InverseDepth, e}}};
   io.writes.push_back({pass.foveated() ? FrameData::SampleSpacing : FrameData::FirstHits, e});
   if (pass.role == StereoRole::Source) io.writes.push_back({FrameData::SourceSurfaces});
+  if (pass.denoiseGuides && !pass.foveated()) io.writes.push_back({FrameData::DenoiseGuides, e});
   if (pass.role == StereoRole::Reuser) {
     io.reads.push_back({FrameData::SourceSurfaces});
     io.reads.push_back({FrameData::RenderedImage, int(Eye::Left)});
@@ -53,9 +58,29 @@ StageIO eyePassIO(const EyePass& pass) {
   return io;
 }
 
-StageIO temporalIO(Eye eye, bool foveated) {
+StageIO denoiseIO(const EyePass& pass) {
+  const int e = int(pass.eye);
+  StageIO io{Stage::Denoise, {{FrameData::RenderedImage, e}, {FrameData::InverseDepth, e}}, {{FrameData::DenoisedImage, e}}};
+  if (pass.foveated()) {
+    io.reads.push_back({FrameData::SampleSpacing, e});
+    return io;
+  }
+  io.reads.push_back({FrameData::DenoiseGuides, e});
+  if (pass.role == StereoRole::Reuser) {
+    const int left = int(Eye::Left);
+    io.reads.push_back({FrameData::ReusedFrom, e});
+    io.reads.push_back({FrameData::RenderedImage, left});
+    io.reads.push_back({FrameData::DenoiseGuides, left});
+    io.reads.push_back({FrameData::DenoisedImage, left});
+  }
+  return io;
+}
+
+StageIO temporalIO(Eye eye, bool foveated, bool denoised) {
   const int e = int(eye);
-  StageIO io{Stage::Temporal, {{FrameData::RenderedImage, e}, {FrameData::InverseDepth, e}}, {{FrameData::DisplayedImage, e}}};
+  StageIO io{Stage::Temporal,
+             {{denoised ? FrameData::DenoisedImage : FrameData::RenderedImage, e}, {FrameData::InverseDepth, e}},
+             {{FrameData::DisplayedImage, e}}};
   if (foveated) io.reads.push_back({FrameData::SampleSpacing, e});
   return io;
 }
@@ -76,20 +101,75 @@ FrameRenderer::FrameRenderer(std::unique_ptr<FrameBackend> backend) : backend_(s
   if (!backend_) throw Error("a frame renderer needs a backend");
 }
 
+namespace {
+
+// Whether two frames' options make the same picture, so that a still head may refine across them.
+bool samePicture(const RenderOptions& a, const RenderOptions& b) {
+  const GatherParams &ga = a.gather, &gb = b.gather;
+  bool same = a.photonsX == b.photonsX && a.photonsY == b.photonsY && a.maxPhotonDepth == b.maxPhotonDepth &&
+              a.map == b.map && ga.density.radius == gb.density.radius && ga.density.estimator == gb.density.estimator &&
+              ga.density.k == gb.density.k && ga.mode == gb.mode && ga.maxSpecularDepth == gb.maxSpecularDepth &&
+              ga.samplesPerPixel == gb.samplesPerPixel && ga.punctualShadowRays == gb.punctualShadowRays &&
+              ga.seed == gb.seed && a.eyes[0] == b.eyes[0] && a.eyes[1] == b.eyes[1] && a.stereo == b.stereo &&
+              a.foveation.mask == b.foveation.mask && a.temporal.enabled == b.temporal.enabled;
+  for (int e = 0; e < 2 && same && a.foveation.mask; ++e)
+    same = a.foveation.gaze[e][0] == b.foveation.gaze[e][0] && a.foveation.gaze[e][1] == b.foveation.gaze[e][1];
+  return same;
+}
+
+// Whether the head moved less than the tolerances between two rigs of the same eyes.
+bool stillView(const StereoRig& a, const StereoRig& b, const DenoiseParams& p) {
+  if (a.width != b.width || a.height != b.height || a.ipd != b.ipd) return false;
+  for (int e = 0; e < 2; ++e) {
+    const Fov &fa = a.fov[e], &fb = b.fov[e];
+    if (fa.angleLeft != fb.angleLeft || fa.angleRight != fb.angleRight || fa.angleUp != fb.angleUp ||
+        fa.angleDown != fb.angleDown)
+      return false;
+  }
+  const Quat &qa = a.head.orientation, &qb = b.head.orientation;
+  const float cosHalf = std::fabs(qa.x * qb.x + qa.y * qb.y + qa.z * qb.z + qa.w * qb.w);
+  const float angleDegrees = 2.0f * std::acos(std::fmin(1.0f, cosHalf)) * 180.0f / kPi;
+  return length(a.head.position - b.head.position) <= p.stillPosition && angleDegrees <= p.stillAngleDegrees;
+}
+
+}  // namespace
+
 void FrameRenderer::resetHistory() {
-  for (Eye e : {Eye::Left, Eye::Right}) backend_->forgetHistory(e);
+  lastRig_.reset();
+  stillFrames_ = 0;
+  for (Eye e : {Eye::Left, Eye::Right}) {
+    backend_->forgetHistory(e);
+    backend_->forgetDenoiseHistory(e);
+  }
 }
 
 const Vec3* FrameRenderer::deviceImage(Eye eye) const {
-  return rendered_[int(eye)] ? backend_->deviceImage(eye, displayed_[int(eye)]) : nullptr;
+  return rendered_[int(eye)] ? backend_->deviceImage(eye, shown_[int(eye)]) : nullptr;
 }
 
 const float* FrameRenderer::deviceInverseDepth(Eye eye) const {
   return rendered_[int(eye)] ? backend_->deviceInverseDepth(eye) : nullptr;
 }
 
-FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& options, bool images) {
-  validateOptions(options, rig);
+FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& requested, bool images) {
+  validateOptions(requested, rig);
+  RenderOptions options = requested;
+  if (requested.temporal.enabled || requested.denoise.enabled) {
+    if (freshNoise_) options.gather.seed = hashCombine(requested.gather.seed, 0x7e3a9u + blendedFrames_);
+    ++blendedFrames_;
+  }
+  // A still head refines: each still frame's photons are gathered with a smaller radius.
+  const DenoiseParams& refine = requested.denoise.params;
+  const bool still = requested.denoise.enabled && refine.refineWhenStill && lastRig_ &&
+                     stillView(rig, *lastRig_, refine) && samePicture(requested, lastOptions_);
+  stillFrames_ = still ? stillFrames_ + 1 : 0;
+  lastRig_ = rig;
+  lastOptions_ = requested;
+  if (stillFrames_ > 0) {
+    const float first = requested.gather.density.radius;
+    options.gather.density.radius =
+        std::max(progressiveRadius(first, stillFrames_, refine.refineAlpha), first * refine.minRadiusFraction);
+  }
   rendered_[0] = rendered_[1] = false;
   FrameBackend& backend = *backend_;
   StageClock& clock = backend.clock();
@@ -114,7 +194,8 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& opt
   for (Eye eye : {Eye::Left, Eye::Right}) {
     const int e = int(eye);
     if (!options.eyes[e]) {
-      backend.forgetHistory(eye);  // its history would be stale when it comes back
+      backend.forgetHistory(eye);  // its histories would be stale when it comes back
+      backend.forgetDenoiseHistory(eye);
       continue;
     }
     EyePass pass;
@@ -123,6 +204,8 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& opt
     pass.gather = options.gather;
     pass.map = options.map;
     pass.kernel = options.kernel;
+    pass.denoiseGuides = options.denoise.enabled;
+    pass.stillFrames = stillFrames_;
     pass.role = !reusing ? StereoRole::Alone : eye == Eye::Left ? StereoRole::Source : StereoRole::Reuser;
     if (pass.role == StereoRole::Reuser) {
       pass.reuse = options.stereo;
@@ -148,19 +231,28 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& opt
     }
     flow.run(eyePassIO(pass));
     backend.renderEye(pass);  // times its own parts
+    if (options.denoise.enabled) {
+      flow.run(denoiseIO(pass));
+      StageScope scope(clock, Stage::Denoise, e);
+      backend.denoise(pass, options.denoise.params);
+    } else {
+      backend.forgetDenoiseHistory(eye);
+    }
     if (!options.temporal.enabled) {
       backend.forgetHistory(eye);
       continue;
     }
-    flow.run(temporalIO(eye, pass.foveated()));
+    flow.run(temporalIO(eye, pass.foveated(), options.denoise.enabled));
     StageScope scope(clock, Stage::Temporal, e);
-    backend.resolveTemporal(eye, pass.camera, options.temporal.taa, pass.foveated());
+    backend.resolveTemporal(eye, pass.camera, options.temporal.taa, pass.foveated(), options.denoise.enabled);
   }
 
   const FrameCounters counters = backend.finishFrame();
   for (int e = 0; e < 2; ++e) {
     rendered_[e] = options.eyes[e];
-    displayed_[e] = flow.has(FrameData::DisplayedImage, e);
+    shown_[e] = flow.has(FrameData::DisplayedImage, e)  ? EyeImage::Displayed
+                : flow.has(FrameData::DenoisedImage, e) ? EyeImage::Denoised
+                                                        : EyeImage::Rendered;
   }
   frame.reusedPixels = counters.reusedSamples;
   frame.deviceBytes = counters.deviceBytes;
@@ -175,15 +267,17 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& opt
     t.eyeRayMs[e] = clock.ms(Stage::EyeRays, e);
     t.densityMs[e] = clock.ms(Stage::Density, e);
     t.reconstructMs[e] = clock.ms(Stage::Reconstruct, e);
+    t.denoiseMs[e] = clock.ms(Stage::Denoise, e);
     t.temporalMs[e] = clock.ms(Stage::Temporal, e);
-    t.eyeMs[e] = t.eyeRayMs[e] + t.densityMs[e] + t.reconstructMs[e] + t.temporalMs[e] + clock.ms(Stage::Scatter, e);
+    t.eyeMs[e] = t.eyeRayMs[e] + t.densityMs[e] + t.reconstructMs[e] + t.denoiseMs[e] + t.temporalMs[e] +
+                 clock.ms(Stage::Scatter, e);
   }
   if (!images) return frame;
   for (Eye eye : {Eye::Left, Eye::Right}) {
     const int e = int(eye);
     if (!options.eyes[e]) continue;
     EyeReadback what;
-    what.displayed = flow.has(FrameData::DisplayedImage, e);
+    what.image = shown_[e];
     what.firstPrim = flow.has(FrameData::FirstHits, e);
     what.sampleSpacing = flow.has(FrameData::SampleSpacing, e);
     what.reusedFrom = flow.has(FrameData::ReusedFrom, e);

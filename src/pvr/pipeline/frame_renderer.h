@@ -1,12 +1,14 @@
 #pragma once
 // The frame pipeline, written once over any backend's stages (frame_backend.h):
 //
-//   validate -> photon trace -> map build -> left eye pass [-> temporal]
-//            -> (scatter) -> (vergence) -> right eye pass [-> temporal] -> finish -> read back
+//   validate -> photon trace -> map build -> left eye pass [-> denoise] [-> temporal]
+//            -> (scatter) -> (vergence) -> right eye pass [-> denoise] [-> temporal] -> finish
+//            -> read back
 //
 // The left eye goes first: under stereo reuse the right eye reads its surfaces and image, and
 // under vergence its depth at the gaze.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "pvr/pipeline/frame_backend.h"
@@ -22,8 +24,16 @@ class FrameRenderer {
   // image is blended with the history of the frames before (kept per eye; an eye whose size
   // changed, or that was skipped, starts again). Throws OptionError for options out of range.
   FrameResult render(const StereoRig& rig, const RenderOptions& options, bool images = true);
-  // Forgets the TAA history (a cut: the next frame is shown as rendered).
+  // Forgets the TAA and denoising histories (a cut: the next frame starts again).
   void resetHistory();
+  // While a temporal stage (TAA, the denoiser) blends frames, each frame draws new random numbers
+  // (photons, shadow rays, sub-pixel positions: the seed mixed with a count of such frames), so
+  // that blending averages the noise away rather than keeping one pattern; frames that blend
+  // nothing draw the seed's numbers (a still head sees a still image). Off: always the seed's.
+  void setFreshNoisePerFrame(bool on) { freshNoise_ = on; }
+  // Frames the view has been still before the last one (the denoiser refines while this grows;
+  // 0: it moved, or refinement is off).
+  int stillFrames() const { return stillFrames_; }
   // The last frame's displayed image of an eye in GPU memory (linear RGB, row-major, the rig's
   // size), valid until the next frame; null on the CPU backend or for an eye not rendered.
   const Vec3* deviceImage(Eye eye) const;
@@ -43,7 +53,13 @@ class FrameRenderer {
 
  private:
   std::unique_ptr<FrameBackend> backend_;
-  bool rendered_[2] = {false, false}, displayed_[2] = {false, false};  ///< the last frame's
+  bool freshNoise_ = true;
+  std::optional<StereoRig> lastRig_;  ///< the last frame's view and options: is this one still?
+  RenderOptions lastOptions_;
+  int stillFrames_ = 0;
+  uint32_t blendedFrames_ = 0;         ///< frames rendered with a temporal stage (the noise's frame number)
+  bool rendered_[2] = {false, false};  ///< the last frame's
+  EyeImage shown_[2] = {EyeImage::Rendered, EyeImage::Rendered};
 };
 
 }  // namespace pvr

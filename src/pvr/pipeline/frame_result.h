@@ -21,13 +21,15 @@ struct StageTimings {
   double scatterMs = 0;
   // Foveated: the reconstruction of each eye's image from its mask vertices (in eyeMs).
   double reconstructMs[2] = {0, 0};
+  // Denoising each eye's image (in eyeMs).
+  double denoiseMs[2] = {0, 0};
   // TAA: resolving each eye's image against its history (in eyeMs).
   double temporalMs[2] = {0, 0};
   double totalMs() const { return photonTraceMs + mapBuildMs + eyeMs[0] + eyeMs[1]; }
 };
 
 struct EyeResult {
-  Image image;  ///< what the eye is shown: after TAA when it is on
+  Image image;  ///< what the eye is shown: denoised and after TAA when they are on
   /// Per pixel, 1 / view depth of what it shows (0: nothing hit); foveated: blended from the
   /// vertices' like the colour.
   std::vector<float> inverseDepth;

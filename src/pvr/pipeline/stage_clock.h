@@ -14,6 +14,7 @@ enum class Stage : int {
   EyeRays,          ///< eye rays to their gather points (the whole shading for fused passes)
   Density,          ///< density estimation at the gather points
   Reconstruct,      ///< foveated: the image rebuilt from the mask's vertices
+  Denoise,          ///< spatio-temporal denoising of the eye's image
   Temporal,         ///< TAA resolve against the eye's history
   Count,
 };

@@ -18,6 +18,7 @@ ProgressiveReference::ProgressiveReference(FrameRenderer& renderer, const Stereo
   options_.stereo = StereoMode::Separate;
   options_.foveation.mask = nullptr;
   options_.temporal.enabled = false;
+  options_.denoise.enabled = false;
   options_.gather.jitterFirstSample = settings.boxFilter;
   validateOptions(options_, rig_);
   const size_t values = size_t(rig_.width) * rig_.height * 3;
@@ -26,9 +27,7 @@ ProgressiveReference::ProgressiveReference(FrameRenderer& renderer, const Stereo
 }
 
 float ProgressiveReference::radiusOfPass(int pass) const {
-  double r2 = 1.0;
-  for (int i = 1; i <= pass; ++i) r2 *= (double(i) + settings_.alpha) / (double(i) + 1.0);
-  return float(double(options_.gather.density.radius) * std::sqrt(r2));
+  return progressiveRadius(options_.gather.density.radius, pass, settings_.alpha);
 }
 
 void ProgressiveReference::addPass() {

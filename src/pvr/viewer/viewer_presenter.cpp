@@ -262,6 +262,7 @@ struct ViewerPresenter::Impl {
       if (settings.foveated) ImGui::Combo("acuity", &settings.acuity, acuities, 2);
       ImGui::Checkbox("TAA", &settings.taa);
       if (settings.taa) ImGui::SliderFloat("TAA blend", &settings.taaBlend, 0.02f, 1.0f);
+      ImGui::Checkbox("denoise", &settings.denoise);
       ImGui::SliderFloat("exposure", &settings.exposure, 0.1f, 8.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
       ImGui::Checkbox("both eyes (Tab)", &settings.bothEyes);
       ImGui::Separator();
@@ -507,6 +508,7 @@ void ViewerPresenter::adjustOptions(RenderOptions& o) {
   o.eyes[1] = s.bothEyes;
   if (s.taa != a.taa) o.temporal.enabled = s.taa;
   if (s.taaBlend != a.taaBlend) o.temporal.taa.blend = s.taaBlend;
+  if (s.denoise != a.denoise) o.denoise.enabled = s.denoise;
   if (s.foveated != a.foveated || (s.foveated && s.acuity != a.acuity)) {
     if (s.foveated) {
       MaskParams params = maskParamsForRig(m.rig);

@@ -26,6 +26,7 @@ struct ViewerSettings {
   int acuity = 0;                  ///< 0 linear, 1 geisler-perry
   bool taa = false;
   float taaBlend = 0.1f;
+  bool denoise = false;
   float exposure = 1.0f;
   int backend = 0;                 ///< 0 cpu, 1 cuda
   bool bothEyes = true;

@@ -1,0 +1,85 @@
+#include "pvr/denoise/host_denoiser.h"
+
+#include <atomic>
+
+#include "pvr/util/error.h"
+#include "pvr/util/parallel_for.h"
+
+namespace pvr {
+namespace {
+
+template <class Body>
+void forEachPixel(const char* what, const EyeCamera& camera, const Body& body) {
+  parallelFor(what, size_t(camera.height), 8, [&](size_t begin, size_t end) {
+    for (int y = int(begin); y < int(end); ++y)
+      for (int x = 0; x < camera.width; ++x) body(x, y);
+  });
+}
+
+}  // namespace
+
+size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams& params, const DenoiseInputs& in,
+                             Image& out, int stillFrames) {
+  if (!in.image || !in.inverseDepth) throw Error("the denoiser needs the eye's image and its per-pixel depth");
+  EyeState& state = eyes_[int(eye)];
+  const size_t pixels = size_t(camera.width) * camera.height;
+  const int signals = in.direct ? 2 : 1;
+  if (state.valid && (state.camera.width != camera.width || state.camera.height != camera.height || state.signals != signals))
+    state.valid = false;
+  const History& previous = state.history[state.latest];
+  History& next = state.history[state.latest ^ 1];
+  for (int s = 0; s < signals; ++s) {
+    next.colour[s].resize(pixels);
+    state.accumulated[s].resize(pixels);
+    state.filtered[s][0].resize(pixels);
+    state.filtered[s][1].resize(pixels);
+  }
+  next.moments.resize(4 * pixels);
+  next.length.resize(pixels);
+  next.guide.resize(pixels);
+  state.albedo.resize(pixels);
+  out = Image(camera.width, camera.height);
+
+  DenoiseFrameView v;
+  v.camera = camera;
+  v.in = in;
+  v.params = params;
+  v.stillFrames = stillFrames;
+  if (state.valid) {
+    v.history.camera = state.camera;
+    for (int s = 0; s < signals; ++s) v.history.colour[s] = previous.colour[s].data();
+    v.history.moments = previous.moments.data();
+    v.history.length = previous.length.data();
+    v.history.guide = previous.guide.data();
+  }
+  v.albedo = state.albedo.data();
+  v.guide = next.guide.data();
+  v.moments = next.moments.data();
+  v.length = next.length.data();
+  for (int s = 0; s < signals; ++s) {
+    v.accumulated[s] = state.accumulated[s].data();
+    v.filtered[s][0] = state.filtered[s][0].data();
+    v.filtered[s][1] = state.filtered[s][1].data();
+    v.historyOut[s] = next.colour[s].data();
+  }
+  v.out = out.pixels.data();
+
+  std::atomic<size_t> used{0};
+  forEachPixel("denoise accumulate", camera, [&](int x, int y) {
+    if (accumulateDenoisePixel(v, x, y)) used.fetch_add(1, std::memory_order_relaxed);
+  });
+  if (params.iterations == 0) {
+    forEachPixel("denoise remodulate", camera, [&](int x, int y) { remodulateAccumulated(v, x, y); });
+  } else {
+    forEachPixel("denoise variance", camera, [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
+    for (int i = 0; i < params.iterations; ++i)
+      forEachPixel("denoise a-trous", camera, [&](int x, int y) { atrousDenoisePixel(v, i, x, y); });
+  }
+  state.latest ^= 1;
+  state.camera = camera;
+  state.signals = signals;
+  state.valid = true;
+  return used;
+}
+
+}  // namespace pvr

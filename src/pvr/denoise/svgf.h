@@ -1,0 +1,439 @@
+#pragma once
+// Spatio-temporal variance-guided filtering of one eye's image (SVGF: Schied et al., HPG 2017),
+// host+device, shared by the CPU and CUDA backends. Per frame:
+//
+//   1. demodulate: the eye pass's direct part (shadow rays) and its photon-map part (image -
+//      direct) are each divided by the gather surface's albedo, so the filter sees irradiance-like
+//      signals and texture detail survives; what was emitted along the path (a light or the sky
+//      seen) has no noise and is left out, to be added back as it was;
+//   2. accumulate: each signal, and its luminance's first two moments, blend with the history
+//      reprojected through the frame's depth and both cameras (a still or turning head), the
+//      history's 2x2 taps kept only where they saw the same surface (depth and normal);
+//   3. variance: from the moments, or from a 7x7 neighbourhood where the history is short;
+//   4. filter: a few a-trous wavelet passes (5x5 B3-spline taps at steps 1, 2, 4, ...) with
+//      edge-stopping weights on depth (a plane through the pixel, so slanted floors filter),
+//      normals and luminance (scaled by the local standard deviation); the first pass's output
+//      becomes the history;
+//   5. remodulate by the same albedo and add the emitted part: a noise-free signal comes back as
+//      it went in.
+//
+// Foveated frames are rebuilt from samples several pixels apart: every step is scaled by the
+// local sample spacing, so the taps land on neighbouring samples as they do on pixels at full
+// resolution. Where no guides exist (foveated eyes give only depth) the signal is the whole image.
+#include "pvr/camera/stereo_rig.h"
+#include "pvr/stereo/stereo_reuse.h"
+#include "pvr/temporal/taa.h"
+
+namespace pvr {
+
+struct DenoiseParams {
+  int iterations = 5;            ///< a-trous passes (0: temporal accumulation only)
+  float colourAlpha = 0.2f;      ///< the current frame's least weight in the accumulated colour
+  float momentsAlpha = 0.2f;     ///< the same for the luminance moments
+  float sigmaLuminance = 4.0f;   ///< luminance edge-stopping, in local standard deviations
+  float normalPower = 128.0f;    ///< normal edge-stopping: cos^power
+  float depthTolerance = 0.02f;  ///< relative inverse-depth difference off the pixel's plane: another surface
+  // Progressive refinement while the head is still (within the tolerances below from the last
+  // frame): the frames' signals are averaged with 1 / n (not the moving head's alpha floor), new
+  // photons each frame with a radius shrinking by Knaus-Zwicker's rule (refineAlpha, down to
+  // minRadiusFraction of the first), and the filter fades out as the average's own variance
+  // falls, so the picture converges to the unbiased image. Any movement returns to the moving
+  // head's weights: the average then fades out of the history at colourAlpha per frame, no pop.
+  bool refineWhenStill = true;
+  float stillPosition = 1e-3f;      ///< head movement (scene units) that still counts as still
+  float stillAngleDegrees = 0.05f;  ///< head rotation that still counts as still
+  float refineAlpha = 0.7f;
+  float minRadiusFraction = 0.25f;
+};
+
+// The denoise stage's options.
+struct DenoiseOptions {
+  bool enabled = false;
+  DenoiseParams params;
+};
+
+constexpr int kMaxDenoiseIterations = 8;
+// Normals closer than this (cosine, 26 degrees) may belong to one surface; farther, never blend.
+constexpr float kDenoiseMinNormalCosine = 0.9f;
+// History is short (the variance comes from the neighbourhood) below this many frames.
+constexpr float kDenoiseShortHistory = 4.0f;
+// Frames a history counts at most (refinement averages this many still frames).
+constexpr float kDenoiseMaxHistory = 65535.0f;
+
+// A demodulated colour and the variance of its luminance.
+struct alignas(16) ColourVariance {
+  Vec3 colour{0, 0, 0};
+  float variance = 0.0f;
+};
+
+// What the filter compares between two pixels: the surface's normal (zero: none known) and
+// 1 / view depth (0: nothing hit).
+struct alignas(16) DenoiseGuide {
+  Vec3 normal{0, 0, 0};
+  float inverseDepth = 0.0f;
+};
+
+// Per-pixel inputs of one eye, as the eye pass wrote them (null: not available).
+struct DenoiseInputs {
+  const Vec3* image = nullptr;          ///< the rendered radiance
+  const Vec3* emitted = nullptr;        ///< its emitted part (with direct; null: none)
+  const Vec3* direct = nullptr;         ///< its direct part (emitted included); null: all of it is one signal
+  const Vec3* albedo = nullptr;         ///< the demodulation albedo; null: 1
+  const Vec3* normal = nullptr;         ///< the gather surface's normal; null: no normal test
+  const float* inverseDepth = nullptr;  ///< required
+  const float* sampleSpacing = nullptr; ///< foveated; null: 1
+  // The right eye under stereo reuse: per pixel the left pixel it reused (kNotReused: none), and
+  // the left eye's inputs and denoised image there.
+  const uint32_t* reusedFrom = nullptr;
+  const Vec3* sourceImage = nullptr;
+  const Vec3* sourceEmitted = nullptr;
+  const Vec3* sourceDirect = nullptr;
+  const Vec3* sourceAlbedo = nullptr;
+  const Vec3* sourceNormal = nullptr;
+  const Vec3* sourceDenoised = nullptr;
+};
+
+// One eye's denoising history: the filtered colours, moments, history length and guides of its
+// last frame.
+struct DenoiseHistoryView {
+  EyeCamera camera;
+  const ColourVariance* colour[2] = {nullptr, nullptr};  ///< direct, photon map
+  const float* moments = nullptr;                        ///< 4 per pixel: mean, mean square of each signal's luminance
+  const float* length = nullptr;                         ///< frames accumulated
+  const DenoiseGuide* guide = nullptr;
+  PVR_HOST_DEVICE bool valid() const { return guide != nullptr; }
+};
+
+// One frame's working buffers of one eye (all the eye's size).
+struct DenoiseFrameView {
+  EyeCamera camera;
+  DenoiseInputs in;
+  DenoiseParams params;
+  int stillFrames = 0;  ///< frames the view has been still before this one (0: moving; refinement)
+  DenoiseHistoryView history;
+  Vec3* albedo = nullptr;                          ///< the demodulation albedo used (as remodulated)
+  DenoiseGuide* guide = nullptr;                   ///< becomes the history's
+  ColourVariance* accumulated[2] = {nullptr, nullptr};
+  float* moments = nullptr;                        ///< becomes the history's
+  float* length = nullptr;                         ///< becomes the history's
+  ColourVariance* filtered[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};  ///< a-trous ping-pong per signal
+  ColourVariance* historyOut[2] = {nullptr, nullptr};  ///< the first pass's output: the next frame's history
+  Vec3* out = nullptr;                             ///< the denoised image
+  PVR_HOST_DEVICE int twoSignals() const { return in.direct ? 2 : 1; }
+};
+
+PVR_HOST_DEVICE inline size_t denoisePixel(const EyeCamera& c, int x, int y) { return size_t(y) * c.width + x; }
+
+// A pixel's local sample spacing as an integer step (1 at full resolution).
+PVR_HOST_DEVICE inline int denoiseSpacing(const DenoiseFrameView& v, size_t pixel) {
+  if (!v.in.sampleSpacing) return 1;
+  float s = v.in.sampleSpacing[pixel];
+  return s > 1.5f ? int(s + 0.5f) : 1;
+}
+
+// Divides by the albedo where it can be divided by (a black channel keeps its value).
+PVR_HOST_DEVICE inline Vec3 demodulationAlbedo(Vec3 a) {
+  const float kMin = 1e-3f;
+  return {a.x > kMin ? a.x : 1.0f, a.y > kMin ? a.y : 1.0f, a.z > kMin ? a.z : 1.0f};
+}
+PVR_HOST_DEVICE inline Vec3 divide(Vec3 a, Vec3 b) { return {a.x / b.x, a.y / b.y, a.z / b.z}; }
+
+// Whether two guides may be the same surface, and if so how unlike they are: `penalty` is the
+// exponent of their weight, exp(-penalty). `dx`, `dy` are q's offset from p in pixels and (gx, gy)
+// p's inverse-depth gradient: inverse depth is affine across a plane in screen space, so q is
+// compared with p's plane extended to it. (The penalties of depth, normal and luminance add up,
+// so that a tap costs one exponential per signal.)
+PVR_HOST_DEVICE inline bool sameSurface(const DenoiseGuide& p, const DenoiseGuide& q, float gx, float gy, float dx,
+                                        float dy, const DenoiseParams& params, float& penalty) {
+  penalty = 0.0f;
+  if ((p.inverseDepth > 0.0f) != (q.inverseDepth > 0.0f)) return false;  // background never meets a surface
+  if (p.inverseDepth > 0.0f) {
+    const float predicted = p.inverseDepth + gx * dx + gy * dy;
+    const float difference = fabsf(q.inverseDepth - predicted);
+    const float tolerance = params.depthTolerance * fmaxf(p.inverseDepth, q.inverseDepth);
+    if (!(difference <= tolerance)) return false;
+    penalty = difference / tolerance;
+  }
+  const bool pHas = !isBlack(p.normal), qHas = !isBlack(q.normal);
+  if (pHas != qHas) return false;
+  if (pHas) {
+    const float c = dot(p.normal, q.normal);
+    if (!(c >= kDenoiseMinNormalCosine)) return false;
+    penalty -= params.normalPower * logf(fminf(c, 1.0f));  // weight cos^power
+  }
+  return true;
+}
+
+// The same as a weight in [0, 1] (0: never blend).
+PVR_HOST_DEVICE inline float geometryWeight(const DenoiseGuide& p, const DenoiseGuide& q, float gx, float gy, float dx,
+                                            float dy, const DenoiseParams& params) {
+  float penalty;
+  return sameSurface(p, q, gx, gy, dx, dy, params, penalty) ? expf(-penalty) : 0.0f;
+}
+
+// The inverse-depth gradient at pixel (x, y), per pixel: the smaller one-sided difference on
+// each axis among neighbours on the same side of any edge (zero where neither is).
+PVR_HOST_DEVICE inline void inverseDepthGradient(const float* inverseDepth, const EyeCamera& c, int x, int y, int step,
+                                                 float& gx, float& gy) {
+  const float centre = inverseDepth[denoisePixel(c, x, y)];
+  auto axis = [&](int ax, int ay) {
+    float best = 0.0f;
+    bool found = false;
+    for (int side = -1; side <= 1; side += 2) {
+      const int qx = x + side * ax * step, qy = y + side * ay * step;
+      if (qx < 0 || qy < 0 || qx >= c.width || qy >= c.height) continue;
+      const float g = (inverseDepth[denoisePixel(c, qx, qy)] - centre) * float(side) / float(step);
+      if (!found || fabsf(g) < fabsf(best)) best = g, found = true;
+    }
+    return found && fabsf(best) <= 0.5f * centre ? best : 0.0f;  // a jump is an edge, not a slope
+  };
+  gx = centre > 0.0f ? axis(1, 0) : 0.0f;
+  gy = centre > 0.0f ? axis(0, 1) : 0.0f;
+}
+
+// The pixel's inputs: demodulated signals, albedo and guide; a reused pixel takes the left eye's.
+PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t pixel, Vec3 signal[2], Vec3& albedo,
+                                              DenoiseGuide& guide) {
+  const DenoiseInputs& in = v.in;
+  const uint32_t source = in.reusedFrom ? in.reusedFrom[pixel] : kNotReused;
+  const bool reused = source != kNotReused;
+  const Vec3 image = reused ? in.sourceImage[source] : in.image[pixel];
+  const Vec3* emitted = reused ? in.sourceEmitted : in.emitted;
+  const Vec3* direct = reused ? in.sourceDirect : in.direct;
+  const Vec3* albedos = reused ? in.sourceAlbedo : in.albedo;
+  const Vec3* normals = reused ? in.sourceNormal : in.normal;
+  const size_t at = reused ? size_t(source) : pixel;
+  albedo = albedos ? demodulationAlbedo(albedos[at]) : Vec3(1.0f);
+  if (direct) {
+    const Vec3 d = direct[at], e = emitted ? emitted[at] : Vec3(0.0f);
+    signal[0] = divide(max(d - e, Vec3(0.0f)), albedo);
+    signal[1] = divide(max(image - d, Vec3(0.0f)), albedo);
+  } else {
+    signal[0] = divide(image, albedo);
+    signal[1] = Vec3(0.0f);
+  }
+  guide.normal = normals ? normals[at] : Vec3(0.0f);
+  guide.inverseDepth = in.inverseDepth[pixel];
+}
+
+// Step 2 at pixel (x, y): the accumulated signals (variance from the moments), moments, history
+// length and the pixel's guide and albedo. Returns whether the history contributed.
+PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, int x, int y) {
+  const size_t pixel = denoisePixel(v.camera, x, y);
+  Vec3 signal[2], albedo;
+  DenoiseGuide guide;
+  demodulatedInputs(v, pixel, signal, albedo, guide);
+  v.albedo[pixel] = albedo;
+  v.guide[pixel] = guide;
+  float moments[4];
+  for (int s = 0; s < 2; ++s) {
+    const float l = luminance(signal[s]);
+    moments[2 * s] = l, moments[2 * s + 1] = l * l;
+  }
+
+  // The history's 2x2 taps around where the pixel was, those that saw this surface.
+  Vec3 history[2] = {Vec3(0.0f), Vec3(0.0f)};
+  float historyMoments[4] = {0, 0, 0, 0}, historyLength = 0.0f, total = 0.0f;
+  const DenoiseHistoryView& h = v.history;
+  if (h.valid()) {
+    TaaView reprojection;
+    reprojection.camera = v.camera;
+    reprojection.previousCamera = h.camera;
+    reprojection.inverseDepth = v.in.inverseDepth;
+    float px, py, expected;
+    if (reprojectToPrevious(reprojection, x, y, px, py, expected)) {
+      float fx = px - 0.5f, fy = py - 0.5f;
+      const float sx = floorf(fx + 0.5f), sy = floorf(fy + 0.5f);
+      if (fabsf(fx - sx) < kTaaSnapPixels && fabsf(fy - sy) < kTaaSnapPixels) fx = sx, fy = sy;  // a still head
+      const int x0 = int(floorf(fx)), y0 = int(floorf(fy));
+      const float tx = fx - float(x0), ty = fy - float(y0);
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+          const int hx = x0 + i, hy = y0 + j;
+          const float w = (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
+          if (!(w > 0.0f) || hx < 0 || hy < 0 || hx >= h.camera.width || hy >= h.camera.height) continue;
+          const size_t at = denoisePixel(h.camera, hx, hy);
+          const DenoiseGuide& g = h.guide[at];
+          if ((g.inverseDepth > 0.0f) != (expected > 0.0f)) continue;
+          if (expected > 0.0f && !(fabsf(g.inverseDepth - expected) <= v.params.depthTolerance * fmaxf(g.inverseDepth, expected)))
+            continue;
+          if (isBlack(g.normal) != isBlack(guide.normal)) continue;
+          if (!isBlack(guide.normal) && !(dot(g.normal, guide.normal) >= kDenoiseMinNormalCosine)) continue;
+          for (int s = 0; s < v.twoSignals(); ++s) history[s] += h.colour[s][at].colour * w;
+          for (int m = 0; m < 4; ++m) historyMoments[m] += h.moments[4 * at + m] * w;
+          historyLength += h.length[at] * w;
+          total += w;
+        }
+    }
+  }
+  // The frames the accumulated average stands for: one more than the history's. A moving head
+  // keeps 1 / colourAlpha of them (the exponential average's weight); a still head keeps them all
+  // (refinement: a running mean; the moving head's history counts as its 1 / colourAlpha); and a
+  // long refined history, once the head moves, halves each frame down to the moving head's, so the
+  // refined picture fades into the moving one over a few frames instead of dropping out at once.
+  const bool used = total > 0.01f;
+  const bool refining = used && v.stillFrames > 0;
+  const float moving = 1.0f / v.params.colourAlpha;
+  float frames = used ? fminf(historyLength / total + 1.0f, kDenoiseMaxHistory) : 1.0f;
+  if (refining) frames = fminf(frames, float(v.stillFrames) + moving);
+  else if (frames > moving) frames = fmaxf(moving, 0.5f * frames);
+  const float alpha = 1.0f / frames;
+  const float alphaMoments = refining ? alpha : fmaxf(v.params.momentsAlpha, alpha);
+  for (int m = 0; m < 4; ++m) {
+    const float previous = used ? historyMoments[m] / total : 0.0f;
+    moments[m] = previous + (moments[m] - previous) * alphaMoments;
+    v.moments[4 * pixel + m] = moments[m];
+  }
+  v.length[pixel] = frames;
+  for (int s = 0; s < v.twoSignals(); ++s) {
+    const Vec3 previous = used ? history[s] / total : Vec3(0.0f);
+    ColourVariance c;
+    c.colour = previous + (signal[s] - previous) * alpha;
+    c.variance = fmaxf(0.0f, moments[2 * s + 1] - moments[2 * s] * moments[2 * s]);
+    // Beyond the moving head's frames the filter sees the average's variance, so it fades out as
+    // that falls; a refining history is the plain average, never a filtered one.
+    c.variance *= fminf(1.0f, alpha * moving);
+    v.historyOut[s][pixel] = c;  // the first a-trous pass replaces it unless refining
+    v.accumulated[s][pixel] = c;
+  }
+  return used;
+}
+
+// Step 3 at pixel (x, y): where the history is short, the variance from the moments of a 7x7
+// neighbourhood on the same surface; written into the first a-trous input.
+PVR_HOST_DEVICE inline void estimateDenoiseVariance(const DenoiseFrameView& v, int x, int y) {
+  const size_t pixel = denoisePixel(v.camera, x, y);
+  const int signals = v.twoSignals();
+  ColourVariance c[2];
+  for (int s = 0; s < signals; ++s) c[s] = v.accumulated[s][pixel];
+  if (v.length[pixel] < kDenoiseShortHistory) {
+    const DenoiseGuide p = v.guide[pixel];
+    const int step = denoiseSpacing(v, pixel);
+    float gx, gy;
+    inverseDepthGradient(v.in.inverseDepth, v.camera, x, y, step, gx, gy);
+    float sum[4] = {0, 0, 0, 0}, total = 0.0f;
+    for (int j = -3; j <= 3; ++j)
+      for (int i = -3; i <= 3; ++i) {
+        const int qx = x + i * step, qy = y + j * step;
+        if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
+        const size_t q = denoisePixel(v.camera, qx, qy);
+        const float w = (i == 0 && j == 0) ? 1.0f : geometryWeight(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params);
+        if (!(w > 0.0f)) continue;
+        for (int m = 0; m < 4; ++m) sum[m] += v.moments[4 * q + m] * w;
+        total += w;
+      }
+    for (int s = 0; s < signals; ++s) {
+      const float mean = sum[2 * s] / total, meanSquare = sum[2 * s + 1] / total;
+      c[s].variance = fmaxf(0.0f, meanSquare - mean * mean);
+    }
+  }
+  for (int s = 0; s < signals; ++s) v.filtered[s][0][pixel] = c[s];
+}
+
+// The denoised colour of a pixel: its filtered signals remodulated; under stereo reuse a right
+// pixel that took the left eye's shading shows the left eye's denoised colour there instead (one
+// denoise of that surface, not two, and both eyes agree on it).
+PVR_HOST_DEVICE inline void writeDenoised(const DenoiseFrameView& v, size_t pixel, Vec3 demodulated) {
+  const uint32_t source = v.in.reusedFrom ? v.in.reusedFrom[pixel] : kNotReused;
+  if (source != kNotReused) {
+    v.out[pixel] = v.in.sourceDenoised[source];
+    return;
+  }
+  const Vec3 emitted = v.in.direct && v.in.emitted ? v.in.emitted[pixel] : Vec3(0.0f);
+  v.out[pixel] = emitted + demodulated * v.albedo[pixel];
+}
+
+// Whether the pixel is refining this frame: the view is still and the pixel kept its history.
+PVR_HOST_DEVICE inline bool refiningPixel(const DenoiseFrameView& v, size_t pixel) {
+  return v.stillFrames > 0 && v.length[pixel] > 1.5f;
+}
+
+// The B3-spline's 1D weights at offsets -2..2.
+PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.375f : (i == 1 || i == -1) ? 0.25f : 0.0625f; }
+
+// A 3x3 Gaussian of the variance around the pixel over its own surface (the luminance test's
+// scale, less noisy; a noisier surface beside it does not loosen it).
+PVR_HOST_DEVICE inline float blurredVariance(const ColourVariance* in, const DenoiseFrameView& v, const DenoiseGuide& p,
+                                             float gx, float gy, int x, int y, int step) {
+  float sum = 0.0f, total = 0.0f;
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) {
+      const int qx = x + i * step, qy = y + j * step;
+      if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
+      const size_t q = denoisePixel(v.camera, qx, qy);
+      float penalty;
+      if ((i || j) && !sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, penalty)) continue;
+      const float w = (i == 0 ? 0.5f : 0.25f) * (j == 0 ? 0.5f : 0.25f);
+      sum += in[q].variance * w;
+      total += w;
+    }
+  return sum / total;
+}
+
+// Step 4, a-trous pass `iteration` at pixel (x, y): reads filtered[s][iteration & 1], writes the
+// other one (and the history after the first pass); the last pass remodulates into `out`.
+PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int iteration, int x, int y) {
+  const size_t pixel = denoisePixel(v.camera, x, y);
+  const int signals = v.twoSignals();
+  const int from = iteration & 1, to = from ^ 1;
+  const DenoiseGuide p = v.guide[pixel];
+  const int spacing = denoiseSpacing(v, pixel);
+  const int step = spacing << iteration;
+  float gx, gy;
+  inverseDepthGradient(v.in.inverseDepth, v.camera, x, y, spacing, gx, gy);
+  ColourVariance centre[2], result[2];
+  float centreVariance[2];
+  for (int s = 0; s < signals; ++s) {
+    centre[s] = v.filtered[s][from][pixel];
+    centreVariance[s] = blurredVariance(v.filtered[s][from], v, p, gx, gy, x, y, spacing);
+  }
+  Vec3 sum[2] = {Vec3(0.0f), Vec3(0.0f)};
+  float variance[2] = {0, 0}, total[2] = {0, 0};
+  const float lp[2] = {luminance(centre[0].colour), luminance(centre[1].colour)};
+  for (int j = -2; j <= 2; ++j)
+    for (int i = -2; i <= 2; ++i) {
+      const int qx = x + i * step, qy = y + j * step;
+      if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
+      const size_t q = denoisePixel(v.camera, qx, qy);
+      const bool self = i == 0 && j == 0;
+      float geometry = 0.0f;
+      if (!self && !sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, geometry)) continue;
+      const float kernel = atrousKernel(i) * atrousKernel(j);
+      for (int s = 0; s < signals; ++s) {
+        const ColourVariance c = self ? centre[s] : v.filtered[s][from][q];
+        // The larger of the two variances scales the luminance test, so that two pixels weigh each
+        // other alike: a dark pixel whose few samples happened to agree (a small variance) still
+        // takes its bright neighbours' light, as they take its darkness, and the mean stays.
+        const float scale = v.params.sigmaLuminance * sqrtf(fmaxf(centreVariance[s], c.variance)) + 1e-6f;
+        const float w = self ? kernel : kernel * expf(-geometry - fabsf(luminance(c.colour) - lp[s]) / scale);
+        sum[s] += c.colour * w;
+        variance[s] += c.variance * w * w;
+        total[s] += w;
+      }
+    }
+  for (int s = 0; s < signals; ++s) {
+    result[s].colour = sum[s] / total[s];
+    result[s].variance = variance[s] / (total[s] * total[s]);
+    v.filtered[s][to][pixel] = result[s];
+    if (iteration == 0 && !refiningPixel(v, pixel)) v.historyOut[s][pixel] = result[s];
+  }
+  if (iteration == v.params.iterations - 1) {
+    const Vec3 radiance = signals == 2 ? result[0].colour + result[1].colour : result[0].colour;
+    writeDenoised(v, pixel, radiance);
+  }
+}
+
+// Step 5 without a-trous passes (iterations 0): the accumulated signals remodulated, and kept as
+// the history.
+PVR_HOST_DEVICE inline void remodulateAccumulated(const DenoiseFrameView& v, int x, int y) {
+  const size_t pixel = denoisePixel(v.camera, x, y);
+  Vec3 radiance{0, 0, 0};
+  for (int s = 0; s < v.twoSignals(); ++s) {
+    const ColourVariance c = v.accumulated[s][pixel];
+    v.historyOut[s][pixel] = c;
+    radiance += c.colour;
+  }
+  writeDenoised(v, pixel, radiance);
+}
+
+}  // namespace pvr

@@ -1,0 +1,392 @@
+// The spatio-temporal denoiser (denoise/svgf.h) on synthetic frames whose answer is known: a
+// constant signal stays constant, a noise-free one comes back unchanged once its history is long,
+// surfaces of another depth or normal never blend, noise falls while the mean stays, a moving head
+// keeps its history, and foveated taps land only on the samples' spacing.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "pvr/cpu/cpu_frame_backend.h"
+#include "pvr/denoise/host_denoiser.h"
+#include "pvr/image/image_compare.h"
+#include "pvr/reference/progressive_reference.h"
+#include "pvr/scene/scene.h"
+
+namespace pvr {
+namespace {
+
+// A frame of a plane facing the eye: the camera at the origin looking down -Z, every pixel at
+// `depth` with normal +Z, its radiance = albedo * (direct + indirect irradiance).
+struct SyntheticFrame {
+  EyeCamera camera;
+  std::vector<Vec3> image, direct, albedo, normal;
+  std::vector<float> inverseDepth, sampleSpacing;
+
+  SyntheticFrame(int w, int h, float depth = 2.0f) {
+    camera.width = w, camera.height = h;
+    camera.fov = {-0.5f, 0.5f, 0.5f, -0.5f};
+    const size_t n = size_t(w) * h;
+    image.assign(n, Vec3(0.0f)), direct.assign(n, Vec3(0.0f)), albedo.assign(n, Vec3(1.0f));
+    normal.assign(n, Vec3(0, 0, 1));
+    inverseDepth.assign(n, 1.0f / depth);
+  }
+  size_t at(int x, int y) const { return size_t(y) * camera.width + x; }
+  void set(int x, int y, Vec3 a, Vec3 directIrradiance, Vec3 indirectIrradiance) {
+    albedo[at(x, y)] = a;
+    direct[at(x, y)] = a * directIrradiance;
+    image[at(x, y)] = a * (directIrradiance + indirectIrradiance);
+  }
+  DenoiseInputs inputs() const {
+    DenoiseInputs in;
+    in.image = image.data(), in.direct = direct.data(), in.albedo = albedo.data(), in.normal = normal.data();
+    in.inverseDepth = inverseDepth.data();
+    in.sampleSpacing = sampleSpacing.empty() ? nullptr : sampleSpacing.data();
+    return in;
+  }
+};
+
+Vec3 checker(int x, int y) { return ((x / 3 + y / 3) & 1) ? Vec3(0.8f, 0.7f, 0.6f) : Vec3(0.2f, 0.25f, 0.3f); }
+
+// Mean absolute difference of luminance over b's mean.
+double compareImages(const Image& a, const Image& b) {
+  double diff = 0, level = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i)
+    diff += std::fabs(double(luminance(a.pixels[i])) - luminance(b.pixels[i])), level += luminance(b.pixels[i]);
+  return diff / level;
+}
+
+double maxRelativeError(const Image& out, const std::vector<Vec3>& expected) {
+  double worst = 0;
+  for (size_t i = 0; i < expected.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::fabs(double(out.pixels[i][c]) - expected[i][c]) / std::max(1e-6, double(expected[i][c])));
+  return worst;
+}
+
+TEST(Denoise, ConstantIrradianceStaysConstantUnderATexture) {
+  SyntheticFrame f(64, 48);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x) f.set(x, y, checker(x, y), Vec3(0.5f), Vec3(0.3f, 0.2f, 0.1f));
+  HostDenoiser denoiser;
+  Image out;
+  for (int frame = 0; frame < 6; ++frame) {
+    denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out);
+    EXPECT_LT(maxRelativeError(out, f.image), 1e-5) << "frame " << frame;
+  }
+}
+
+TEST(Denoise, NoiseFreeImageIsUnchangedOnceItsHistoryIsLong) {
+  SyntheticFrame f(64, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float e = 0.5f + 0.4f * std::sin(float(x) / 7.0f) * std::cos(float(y) / 5.0f);
+      f.set(x, y, checker(x, y), Vec3(e), Vec3(0.2f * e + 0.05f));
+      if (x > 40 && y > 20 && y < 30) f.direct[f.at(x, y)] = Vec3(0.0f), f.image[f.at(x, y)] = checker(x, y) * 0.1f;  // a hard shadow
+    }
+  HostDenoiser denoiser;
+  Image out;
+  for (int frame = 0; frame < 40; ++frame) denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out);
+  // The first frames (short history, variance from the neighbourhood) blur; their share of the
+  // history falls by 0.8 per frame, and a zero temporal variance stops every tap that differs.
+  EXPECT_LT(maxRelativeError(out, f.image), 2e-3);
+}
+
+// Left half: one surface with noise; right half: another surface (farther, or turned), as bright
+// or 1000 times brighter. The left half must come out the same either way: no left pixel takes
+// any of the right's light, whatever the luminance test says.
+void expectNoBlending(const char* what, float rightDepth, Vec3 rightNormal, float sigmaLuminance) {
+  DenoiseParams params;
+  params.sigmaLuminance = sigmaLuminance;
+  Image left[2];
+  for (int run = 0; run < 2; ++run) {
+    SyntheticFrame f(48, 32);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> noise(0.5f, 1.5f);
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 48; ++x) {
+        const bool right = x >= 24;
+        const float value = (right && run == 1 ? 1000.0f : 1.0f) * noise(rng);
+        f.set(x, y, Vec3(0.5f), Vec3(value), Vec3(0.1f * value));
+        if (right) f.inverseDepth[f.at(x, y)] = 1.0f / rightDepth, f.normal[f.at(x, y)] = rightNormal;
+      }
+    HostDenoiser denoiser;
+    for (int frame = 0; frame < 3; ++frame) denoiser.denoise(Eye::Left, f.camera, params, f.inputs(), left[run]);
+  }
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 24; ++x)
+      ASSERT_EQ(left[0].pixels[size_t(y) * 48 + x], left[1].pixels[size_t(y) * 48 + x]) << what << " at " << x << "," << y;
+}
+
+TEST(Denoise, SurfacesOfAnotherDepthOrNormalNeverBlend) {
+  for (float sigma : {4.0f, 1e6f}) {  // the default luminance test, and none
+    expectNoBlending("depth edge", 2.5f, Vec3(0, 0, 1), sigma);
+    expectNoBlending("small depth step", 2.1f, Vec3(0, 0, 1), sigma);
+    expectNoBlending("normal edge", 2.0f, Vec3(1, 0, 0), sigma);
+    expectNoBlending("crease", 2.0f, normalize(Vec3(0.5f, 0, 0.866f)), sigma);
+  }
+}
+
+TEST(Denoise, NoiseFallsAndTheMeanStays) {
+  SyntheticFrame f(96, 96);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  for (int y = 0; y < 96; ++y)
+    for (int x = 0; x < 96; ++x) f.set(x, y, checker(x, y), Vec3(0.5f * noise(rng)), Vec3(0.2f * noise(rng)));
+  HostDenoiser denoiser;
+  Image out;
+  denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out);
+  // Error against the noise-free answer, albedo * 0.7.
+  double before = 0, after = 0, meanIn = 0, meanOut = 0;
+  for (int y = 0; y < 96; ++y)
+    for (int x = 0; x < 96; ++x) {
+      const double truth = luminance(checker(x, y) * 0.7f);
+      const double in = luminance(f.image[f.at(x, y)]), o = luminance(out.pixels[f.at(x, y)]);
+      before += (in - truth) * (in - truth), after += (o - truth) * (o - truth);
+      meanIn += in, meanOut += o;
+    }
+  EXPECT_LT(after, before / 10.0);
+  EXPECT_NEAR(meanOut / meanIn, 1.0, 0.02);
+}
+
+TEST(Denoise, AMovingHeadKeepsItsHistoryAndADisocclusionDropsIt) {
+  SyntheticFrame f(64, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) f.set(x, y, checker(x, y), Vec3(0.5f), Vec3(0.2f));
+  HostDenoiser denoiser;
+  Image out;
+  EXPECT_EQ(denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out), 0u);
+  SyntheticFrame moved = f;
+  moved.camera.pose.position = Vec3(0.01f, 0.0f, 0.0f);  // 1 cm right: the plane moves about 0.3 px
+  const size_t used = denoiser.denoise(Eye::Left, moved.camera, DenoiseParams(), moved.inputs(), out);
+  EXPECT_GT(used, size_t(64 * 62));  // all but the column that came into view
+  SyntheticFrame nearer = f;
+  for (float& w : nearer.inverseDepth) w = 1.0f / 1.5f;  // another surface in front
+  EXPECT_EQ(denoiser.denoise(Eye::Left, nearer.camera, DenoiseParams(), nearer.inputs(), out), 0u);
+}
+
+TEST(Denoise, FoveatedTapsLandOnTheSampleSpacing) {
+  // Samples every 4 pixels carry the signal; the pixels between them hold a value 100 times
+  // larger. With the spacing given, a sample's taps never read between samples.
+  SyntheticFrame f(64, 64);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> noise(0.5f, 1.5f);
+  float sampleMax = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const bool sample = x % 4 == 0 && y % 4 == 0;
+      const float v = (sample ? 1.0f : 100.0f) * noise(rng);
+      f.set(x, y, Vec3(1.0f), Vec3(v), Vec3(0.0f));
+      if (sample) sampleMax = std::max(sampleMax, v);
+    }
+  f.sampleSpacing.assign(64 * 64, 4.0f);
+  HostDenoiser denoiser;
+  Image out;
+  denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out);
+  for (int y = 0; y < 64; y += 4)
+    for (int x = 0; x < 64; x += 4) ASSERT_LE(out.pixels[f.at(x, y)].x, sampleMax * 1.0001f) << x << "," << y;
+  // Without the spacing the same taps blend the larger values in.
+  f.sampleSpacing.clear();
+  HostDenoiser fullResolution;
+  fullResolution.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out);
+  EXPECT_GT(out.pixels[f.at(32, 32)].x, sampleMax * 2.0f);
+}
+
+// A light seen on the same plane as a noisy dim surface (the Cornell box's ceiling lamp): what was
+// emitted is not filtered, so the lamp keeps its exact radiance and its edge.
+TEST(Denoise, EmittedLightIsLeftAsItWas) {
+  SyntheticFrame f(64, 48);
+  std::vector<Vec3> emitted(64 * 48, Vec3(0.0f));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const bool lamp = x >= 24 && x < 40 && y >= 16 && y < 32;
+      f.set(x, y, Vec3(0.78f), Vec3(0.4f * noise(rng)), Vec3(0.3f * noise(rng)));
+      if (!lamp) continue;
+      emitted[f.at(x, y)] = Vec3(17.0f, 12.0f, 4.0f);
+      f.direct[f.at(x, y)] += emitted[f.at(x, y)];
+      f.image[f.at(x, y)] += emitted[f.at(x, y)];
+    }
+  DenoiseInputs in = f.inputs();
+  in.emitted = emitted.data();
+  HostDenoiser denoiser;
+  Image out;
+  for (int frame = 0; frame < 4; ++frame) {
+    denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), in, out);
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 64; ++x) {
+        const size_t i = f.at(x, y);
+        const Vec3 reflected = out.pixels[i] - emitted[i];
+        ASSERT_GE(reflected.x, 0.0f) << x << "," << y;
+        ASSERT_LT(reflected.x, 2.0f) << "lamp light leaked into " << x << "," << y;
+      }
+  }
+}
+
+// Still frames (refinement) average with 1 / n: the error against the noise-free signal falls as
+// the frames add up, well below what the moving head's weights (alpha 0.2) leave.
+TEST(Denoise, StillFramesAverageTowardsTheNoiseFreeSignal) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  double error[2] = {0, 0};
+  for (int refine = 0; refine < 2; ++refine) {
+    HostDenoiser denoiser;
+    Image out;
+    for (int frame = 0; frame < 120; ++frame) {
+      SyntheticFrame f(48, 48);
+      for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 48; ++x) f.set(x, y, checker(x, y), Vec3(0.5f * noise(rng)), Vec3(0.2f * noise(rng)));
+      denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out, refine ? frame : 0);
+    }
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 48; ++x) {
+        const double d = luminance(out.pixels[size_t(y) * 48 + x] - checker(x, y) * 0.7f) / luminance(checker(x, y) * 0.7f);
+        error[refine] += d * d;
+      }
+  }
+  std::printf("rms relative error after 120 frames: moving weights %.4f, refining %.4f\n", std::sqrt(error[0] / 2304),
+              std::sqrt(error[1] / 2304));
+  EXPECT_LT(error[1], 0.25 * error[0]);  // squared errors; measured 0.14
+}
+
+TEST(Denoise, WithoutGuidesTheWholeImageIsOneSignal) {
+  SyntheticFrame f(32, 32);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) f.set(x, y, Vec3(0.6f), Vec3(0.5f), Vec3(0.25f));
+  DenoiseInputs in;
+  in.image = f.image.data();
+  in.inverseDepth = f.inverseDepth.data();
+  HostDenoiser denoiser;
+  Image out;
+  for (int frame = 0; frame < 3; ++frame) {  // also with a history of one signal
+    denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), in, out, frame);
+    EXPECT_LT(maxRelativeError(out, f.image), 1e-5) << "frame " << frame;
+  }
+}
+
+// The Cornell box through the frame pipeline at real-time settings (one sample per pixel, few
+// photons): the denoised image is nearer the converged reference than the raw one, at once and more
+// so as a still head's history grows, and keeps its mean.
+TEST(DenoiseFrames, TheCornellBoxComesCloserToItsReference) {
+  Scene scene = builtinScene("cornell");
+  StereoRig rig = scene.rig;
+  rig.width = 144, rig.height = 160;  // the filter's steps (up to 16 pixels) need room
+  RenderOptions options;
+  options.eyes[1] = false;
+  options.photonsX = options.photonsY = 96;
+  options.gather.density.radius = 0.05f;
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  Image truth;
+  {
+    RenderOptions converged = options;
+    converged.gather.seed = 99;
+    converged.photonsX = converged.photonsY = 256;
+    ReferenceSettings centre;
+    centre.boxFilter = false;  // as the real-time image samples the pixel centre
+    ProgressiveReference reference(renderer, rig, converged, centre);
+    for (int i = 0; i < 96; ++i) reference.addPass();
+    truth = reference.image(Eye::Left);
+  }
+  FrameRenderer denoising = makeCpuFrameRenderer(scene);
+  double raw = 0, first = 0, later = 0, rawMean = 0, denoisedMean = 0;
+  for (int frame = 0; frame < 8; ++frame) {
+    options.gather.seed = 1 + uint32_t(frame);  // a still head's frames differ only in their random numbers
+    options.denoise.enabled = false;
+    FrameResult plain = renderer.render(rig, options);
+    options.denoise.enabled = true;
+    FrameResult denoised = denoising.render(rig, options);
+    const ReferenceError r = compareToReference(plain.eyes[0].image, truth);
+    const ReferenceError d = compareToReference(denoised.eyes[0].image, truth);
+    if (frame == 0) raw = r.relMse, first = d.relMse, rawMean = r.meanRatio, denoisedMean = d.meanRatio;
+    later = d.relMse;
+  }
+  std::printf("cornell 144x160: relMSE raw %.4g, denoised %.4g (first frame), %.4g (8th); mean ratio %.4f -> %.4f\n", raw,
+              first, later, rawMean, denoisedMean);
+  EXPECT_LT(first, 0.5 * raw);   // measured 0.27 (1 spp, 96x96 photons, r 0.05)
+  EXPECT_LT(later, 0.25 * raw);  // measured 0.16
+  EXPECT_NEAR(denoisedMean / rawMean, 1.0, 0.03);
+}
+
+// A still head refines: after 60 still frames the Cornell box is much nearer its reference than
+// the moving head's weights get it; a small movement then continues from the refined history
+// (a small change, no pop), where a cut would jump.
+TEST(DenoiseFrames, AStillHeadRefinesAndAMoveDoesNotPop) {
+  Scene scene = builtinScene("cornell");
+  StereoRig rig = scene.rig;
+  rig.width = 144, rig.height = 160;
+  RenderOptions options;
+  options.eyes[1] = false;
+  options.photonsX = options.photonsY = 96;
+  options.gather.density.radius = 0.05f;
+  options.denoise.enabled = true;
+  FrameRenderer renderer = makeCpuFrameRenderer(scene);
+  Image truth;
+  {
+    RenderOptions converged = options;
+    converged.denoise.enabled = false;
+    converged.gather.seed = 99;
+    converged.photonsX = converged.photonsY = 256;
+    ReferenceSettings centre;
+    centre.boxFilter = false;
+    ProgressiveReference reference(renderer, rig, converged, centre);
+    for (int i = 0; i < 128; ++i) reference.addPass();
+    truth = reference.image(Eye::Left);
+  }
+  double error[2] = {0, 0};
+  Image still;
+  FrameRenderer refining = makeCpuFrameRenderer(scene);
+  for (int refine = 0; refine < 2; ++refine) {
+    FrameRenderer other = makeCpuFrameRenderer(scene);
+    FrameRenderer& r = refine ? refining : other;
+    RenderOptions o = options;
+    o.denoise.params.refineWhenStill = refine == 1;
+    Image last;
+    for (int frame = 0; frame < 60; ++frame) last = r.render(rig, o).eyes[0].image;
+    EXPECT_EQ(r.stillFrames(), refine ? 59 : 0);
+    error[refine] = compareToReference(last, truth).relMse;
+    if (refine) still = last;
+  }
+  std::printf("cornell 144x160 after 60 still frames: relMSE %.5f with the moving head's weights, %.5f refined\n",
+              error[0], error[1]);
+  EXPECT_LT(error[1], 0.5 * error[0]);
+  // 2 mm: beyond the stillness tolerance, a few pixels' parallax.
+  StereoRig moved = rig;
+  moved.head.position = rig.head.toWorldPoint({0.002f, 0.0f, 0.0f});
+  const Image afterMove = refining.render(moved, options).eyes[0].image;
+  EXPECT_EQ(refining.stillFrames(), 0);
+  refining.resetHistory();
+  const Image afterCut = refining.render(moved, options).eyes[0].image;
+  const double moveChange = compareImages(afterMove, still), cutChange = compareImages(afterCut, still);
+  std::printf("change of the first moving frame: %.4f (a cut: %.4f)\n", moveChange, cutChange);
+  EXPECT_LT(moveChange, 0.5 * cutChange);
+}
+
+// Under full-resolution stereo reuse the right eye's reused pixels show the left eye's denoised
+// colour exactly, and the others are denoised in the right eye.
+TEST(DenoiseFrames, ReusedPixelsShowTheLeftEyesDenoisedColour) {
+  Scene scene = builtinScene("cornell");
+  StereoRig rig = scene.rig;
+  rig.width = 48, rig.height = 54;
+  RenderOptions options;
+  options.photonsX = options.photonsY = 64;
+  options.denoise.enabled = true;
+  for (StereoMode mode : {StereoMode::Gather, StereoMode::Scatter}) {
+    options.stereo = mode;
+    FrameRenderer renderer = makeCpuFrameRenderer(scene);
+    FrameResult f = renderer.render(rig, options);
+    ASSERT_TRUE(f.eyes[1].reusedFrom.has_value());
+    const std::vector<uint32_t>& from = *f.eyes[1].reusedFrom;
+    size_t reused = 0;
+    for (size_t i = 0; i < from.size(); ++i) {
+      if (from[i] == kNotReused) continue;
+      ++reused;
+      ASSERT_EQ(f.eyes[1].image.pixels[i], f.eyes[0].image.pixels[from[i]]) << stereoModeName(mode) << " pixel " << i;
+    }
+    EXPECT_GT(reused, from.size() / 2) << stereoModeName(mode);
+  }
+}
+
+}  // namespace
+}  // namespace pvr
