@@ -36,8 +36,8 @@ class RecordingBackend : public FrameBackend {
   void denoise(const EyePass& pass, const DenoiseParams&) override {
     record(pass.eye == Eye::Left ? "denoise left" : "denoise right");
   }
-  void resolveTemporal(Eye eye, const EyeCamera&, const TaaParams&, bool, bool denoised) override {
-    record(std::string(eye == Eye::Left ? "taa left" : "taa right") + (denoised ? " of denoised" : ""));
+  void resolveTemporal(const TemporalPass& pass) override {
+    record(std::string(pass.eye == Eye::Left ? "taa left" : "taa right") + (pass.denoised ? " of denoised" : ""));
   }
   void forgetHistory(Eye eye) override { record(eye == Eye::Left ? "forget left" : "forget right"); }
   void forgetDenoiseHistory(Eye) override {}
@@ -156,10 +156,17 @@ TEST(FramePipeline, AStageThatReadsWhatNoStageWroteIsAnError) {
   flow.run(eyePassIO(right));
   EXPECT_TRUE(flow.has(FrameData::ReusedFrom, 1));
   EXPECT_FALSE(flow.has(FrameData::DisplayedImage, 1));
-  EXPECT_THROW(flow.run(temporalIO(Eye::Right, true, false)), Error) << "a full-resolution eye has no sample spacing";
-  EXPECT_THROW(flow.run(temporalIO(Eye::Right, false, true)), Error) << "nothing denoised the right eye";
+  auto resolve = [](bool foveated, bool denoised, bool emittedApart) {
+    TemporalPass t;
+    t.eye = Eye::Right;
+    t.foveated = foveated, t.denoised = denoised, t.emittedApart = emittedApart, t.reuser = emittedApart;
+    return t;
+  };
+  EXPECT_THROW(flow.run(temporalIO(resolve(true, false, false))), Error) << "a full-resolution eye has no sample spacing";
+  EXPECT_THROW(flow.run(temporalIO(resolve(false, true, false))), Error) << "nothing denoised the right eye";
+  EXPECT_THROW(flow.run(temporalIO(resolve(false, false, true))), Error) << "the eye passes wrote no guides";
   EXPECT_THROW(flow.run(denoiseIO(right)), Error) << "the eye passes wrote no denoise guides";
-  flow.run(temporalIO(Eye::Right, false, false));
+  flow.run(temporalIO(resolve(false, false, false)));
   EXPECT_TRUE(flow.has(FrameData::DisplayedImage, 1));
 }
 

@@ -146,8 +146,7 @@ TEST(Temporal, DisocclusionDropsHistoryWhereThePreviousEyeDidNotSeeTheSurface) {
   size_t visible = 0, visibleKept = 0, hidden = 0, hiddenDropped = 0;
   for (int y = 0; y < rig.height; ++y)
     for (int x = 0; x < rig.width; ++x) {
-      bool usedHistory;
-      resolveTemporalPixel(view, x, y, usedHistory);
+      const bool usedHistory = resolveTemporalPixel(view, x, y).usedHistory;
       float w = view.inverseDepth[size_t(y) * rig.width + x];
       if (w == 0.0f) continue;  // background
       Vec3 world = view.camera.pointAt(x + 0.5f, y + 0.5f, w);

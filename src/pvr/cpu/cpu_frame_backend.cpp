@@ -128,12 +128,16 @@ void CpuFrameBackend::denoise(const EyePass& pass, const DenoiseParams& params) 
   denoiser_.denoise(pass.eye, pass.camera, params, in, b.denoised, pass.stillFrames);
 }
 
-void CpuFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated,
-                                      bool denoised) {
-  EyeBuffers& b = eyes_[int(eye)];
-  counters_.historyPixels[int(eye)] = pvr::resolveTemporal(camera, params, denoised ? b.denoised : b.rendered, b.inverseDepth,
-                                                           foveated ? b.sampleSpacing.data() : nullptr,
-                                                           history_[int(eye)], b.displayed);
+void CpuFrameBackend::resolveTemporal(const TemporalPass& pass) {
+  EyeBuffers& b = eyes_[int(pass.eye)];
+  TaaEmitted emission;
+  if (pass.emittedApart) {
+    emission.emitted = b.emitted.data();
+    if (pass.reuser) emission.reusedFrom = b.reusedFrom.data(), emission.sourceEmitted = eyes_[int(Eye::Left)].emitted.data();
+  }
+  counters_.historyPixels[int(pass.eye)] =
+      pvr::resolveTemporal(pass.camera, pass.params, pass.denoised ? b.denoised : b.rendered, b.inverseDepth,
+                           pass.foveated ? b.sampleSpacing.data() : nullptr, history_[int(pass.eye)], b.displayed, emission);
 }
 
 FrameCounters CpuFrameBackend::finishFrame() {

@@ -24,7 +24,7 @@ class CpuFrameBackend : public FrameBackend {
   void renderEye(const EyePass& pass) override;
   float inverseDepthAt(Eye eye, size_t pixel) override { return eyes_[int(eye)].inverseDepth.at(pixel); }
   void denoise(const EyePass& pass, const DenoiseParams& params) override;
-  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated, bool denoised) override;
+  void resolveTemporal(const TemporalPass& pass) override;
   void forgetHistory(Eye eye) override { history_[int(eye)].valid = false; }
   void forgetDenoiseHistory(Eye eye) override { denoiser_.forget(eye); }
   FrameCounters finishFrame() override;

@@ -186,12 +186,17 @@ void CudaFrameBackend::denoise(const EyePass& pass, const DenoiseParams& params)
   m.denoiser.denoise(eye, pass.camera, params, in, pass.stillFrames, m.stream);
 }
 
-void CudaFrameBackend::resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated,
-                                       bool denoised) {
+void CudaFrameBackend::resolveTemporal(const TemporalPass& pass) {
   Impl& m = *impl_;
   m.frame.temporal = true;
-  m.temporal.resolve(eye, camera, params, denoised ? m.denoiser.image(eye) : m.eyePass.image(eye),
-                     m.eyePass.inverseDepth(eye), foveated ? m.eyePass.sampleSpacing(eye) : nullptr, m.stream);
+  TaaEmitted emission;
+  if (pass.emittedApart) {
+    emission.emitted = m.eyePass.emitted(pass.eye);
+    if (pass.reuser) emission.reusedFrom = m.eyePass.reusedFrom(), emission.sourceEmitted = m.eyePass.emitted(Eye::Left);
+  }
+  m.temporal.resolve(pass.eye, pass.camera, pass.params, pass.denoised ? m.denoiser.image(pass.eye) : m.eyePass.image(pass.eye),
+                     m.eyePass.inverseDepth(pass.eye), pass.foveated ? m.eyePass.sampleSpacing(pass.eye) : nullptr,
+                     emission, m.stream);
 }
 
 void CudaFrameBackend::forgetHistory(Eye eye) { impl_->temporal.forget(eye); }

@@ -42,7 +42,7 @@ class CudaFrameBackend : public FrameBackend {
   void renderEye(const EyePass& pass) override;
   float inverseDepthAt(Eye eye, size_t pixel) override;
   void denoise(const EyePass& pass, const DenoiseParams& params) override;
-  void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated, bool denoised) override;
+  void resolveTemporal(const TemporalPass& pass) override;
   void forgetHistory(Eye eye) override;
   void forgetDenoiseHistory(Eye eye) override;
   FrameCounters finishFrame() override;

@@ -10,7 +10,7 @@
 //      reprojected through the frame's depth and both cameras (a still or turning head), the
 //      history's 2x2 taps kept only where they saw the same surface (depth and normal);
 //   3. variance: from the moments, or from a 7x7 neighbourhood where the history is short;
-//   4. filter: a few a-trous wavelet passes (5x5 B3-spline taps at steps 1, 2, 4, ...) with
+//   4. filter: a few a-trous wavelet passes (3x3 taps, weights 1/4 1/2 1/4, at steps 1, 2, 4, ...) with
 //      edge-stopping weights on depth (a plane through the pixel, so slanted floors filter),
 //      normals and luminance (scaled by the local standard deviation); the first pass's output
 //      becomes the history;
@@ -21,38 +21,12 @@
 // local sample spacing, so the taps land on neighbouring samples as they do on pixels at full
 // resolution. Where no guides exist (foveated eyes give only depth) the signal is the whole image.
 #include "pvr/camera/stereo_rig.h"
+#include "pvr/denoise/denoise_options.h"
 #include "pvr/stereo/stereo_reuse.h"
 #include "pvr/temporal/taa.h"
 
 namespace pvr {
 
-struct DenoiseParams {
-  int iterations = 5;            ///< a-trous passes (0: temporal accumulation only)
-  float colourAlpha = 0.2f;      ///< the current frame's least weight in the accumulated colour
-  float momentsAlpha = 0.2f;     ///< the same for the luminance moments
-  float sigmaLuminance = 4.0f;   ///< luminance edge-stopping, in local standard deviations
-  float normalPower = 128.0f;    ///< normal edge-stopping: cos^power
-  float depthTolerance = 0.02f;  ///< relative inverse-depth difference off the pixel's plane: another surface
-  // Progressive refinement while the head is still (within the tolerances below from the last
-  // frame): the frames' signals are averaged with 1 / n (not the moving head's alpha floor), new
-  // photons each frame with a radius shrinking by Knaus-Zwicker's rule (refineAlpha, down to
-  // minRadiusFraction of the first), and the filter fades out as the average's own variance
-  // falls, so the picture converges to the unbiased image. Any movement returns to the moving
-  // head's weights: the average then fades out of the history at colourAlpha per frame, no pop.
-  bool refineWhenStill = true;
-  float stillPosition = 1e-3f;      ///< head movement (scene units) that still counts as still
-  float stillAngleDegrees = 0.05f;  ///< head rotation that still counts as still
-  float refineAlpha = 0.7f;
-  float minRadiusFraction = 0.25f;
-};
-
-// The denoise stage's options.
-struct DenoiseOptions {
-  bool enabled = false;
-  DenoiseParams params;
-};
-
-constexpr int kMaxDenoiseIterations = 8;
 // Normals closer than this (cosine, 26 degrees) may belong to one surface; farther, never blend.
 constexpr float kDenoiseMinNormalCosine = 0.9f;
 // History is short (the variance comes from the neighbourhood) below this many frames.
@@ -124,6 +98,30 @@ struct DenoiseFrameView {
 
 PVR_HOST_DEVICE inline size_t denoisePixel(const EyeCamera& c, int x, int y) { return size_t(y) * c.width + x; }
 
+// The filter's exponentials and logarithms: the GPU's fast intrinsics (a few ulp from the host's,
+// far below what the weights need).
+PVR_HOST_DEVICE inline float filterExp(float x) {
+#ifdef __CUDA_ARCH__
+  return __expf(x);
+#else
+  return expf(x);
+#endif
+}
+PVR_HOST_DEVICE inline float filterDivide(float a, float b) {
+#ifdef __CUDA_ARCH__
+  return __fdividef(a, b);
+#else
+  return a / b;
+#endif
+}
+PVR_HOST_DEVICE inline float filterRsqrt(float x) {
+#ifdef __CUDA_ARCH__
+  return rsqrtf(x);
+#else
+  return 1.0f / sqrtf(x);
+#endif
+}
+
 // A pixel's local sample spacing as an integer step (1 at full resolution).
 PVR_HOST_DEVICE inline int denoiseSpacing(const DenoiseFrameView& v, size_t pixel) {
   if (!v.in.sampleSpacing) return 1;
@@ -152,14 +150,15 @@ PVR_HOST_DEVICE inline bool sameSurface(const DenoiseGuide& p, const DenoiseGuid
     const float difference = fabsf(q.inverseDepth - predicted);
     const float tolerance = params.depthTolerance * fmaxf(p.inverseDepth, q.inverseDepth);
     if (!(difference <= tolerance)) return false;
-    penalty = difference / tolerance;
+    penalty = filterDivide(difference, tolerance);
   }
   const bool pHas = !isBlack(p.normal), qHas = !isBlack(q.normal);
   if (pHas != qHas) return false;
   if (pHas) {
     const float c = dot(p.normal, q.normal);
     if (!(c >= kDenoiseMinNormalCosine)) return false;
-    penalty -= params.normalPower * logf(fminf(c, 1.0f));  // weight cos^power
+    // exp(-power (1 - cos)): within a few per cent of cos^power above the cut, without a logarithm.
+    penalty += params.normalPower * fmaxf(0.0f, 1.0f - c);
   }
   return true;
 }
@@ -168,7 +167,7 @@ PVR_HOST_DEVICE inline bool sameSurface(const DenoiseGuide& p, const DenoiseGuid
 PVR_HOST_DEVICE inline float geometryWeight(const DenoiseGuide& p, const DenoiseGuide& q, float gx, float gy, float dx,
                                             float dy, const DenoiseParams& params) {
   float penalty;
-  return sameSurface(p, q, gx, gy, dx, dy, params, penalty) ? expf(-penalty) : 0.0f;
+  return sameSurface(p, q, gx, gy, dx, dy, params, penalty) ? filterExp(-penalty) : 0.0f;
 }
 
 // The inverse-depth gradient at pixel (x, y), per pixel: the smaller one-sided difference on
@@ -218,7 +217,10 @@ PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t 
 
 // Step 2 at pixel (x, y): the accumulated signals (variance from the moments), moments, history
 // length and the pixel's guide and albedo. Returns whether the history contributed.
-PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, int x, int y) {
+// Each pass is written for S signals (1 or 2) known at compile time, so that the per-signal arrays
+// stay in registers on the GPU; the untemplated names choose S from the inputs.
+template <int S>
+PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   Vec3 signal[2], albedo;
   DenoiseGuide guide;
@@ -259,7 +261,7 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, in
             continue;
           if (isBlack(g.normal) != isBlack(guide.normal)) continue;
           if (!isBlack(guide.normal) && !(dot(g.normal, guide.normal) >= kDenoiseMinNormalCosine)) continue;
-          for (int s = 0; s < v.twoSignals(); ++s) history[s] += h.colour[s][at].colour * w;
+          for (int s = 0; s < S; ++s) history[s] += h.colour[s][at].colour * w;
           for (int m = 0; m < 4; ++m) historyMoments[m] += h.moments[4 * at + m] * w;
           historyLength += h.length[at] * w;
           total += w;
@@ -285,7 +287,7 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, in
     v.moments[4 * pixel + m] = moments[m];
   }
   v.length[pixel] = frames;
-  for (int s = 0; s < v.twoSignals(); ++s) {
+  for (int s = 0; s < S; ++s) {
     const Vec3 previous = used ? history[s] / total : Vec3(0.0f);
     ColourVariance c;
     c.colour = previous + (signal[s] - previous) * alpha;
@@ -293,7 +295,7 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, in
     // Beyond the moving head's frames the filter sees the average's variance, so it fades out as
     // that falls; a refining history is the plain average, never a filtered one.
     c.variance *= fminf(1.0f, alpha * moving);
-    v.historyOut[s][pixel] = c;  // the first a-trous pass replaces it unless refining
+    if (refining) v.historyOut[s][pixel] = c;  // else the first a-trous pass (or remodulate) writes it
     v.accumulated[s][pixel] = c;
   }
   return used;
@@ -301,9 +303,10 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, in
 
 // Step 3 at pixel (x, y): where the history is short, the variance from the moments of a 7x7
 // neighbourhood on the same surface; written into the first a-trous input.
-PVR_HOST_DEVICE inline void estimateDenoiseVariance(const DenoiseFrameView& v, int x, int y) {
+template <int S>
+PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
-  const int signals = v.twoSignals();
+  constexpr int signals = S;
   ColourVariance c[2];
   for (int s = 0; s < signals; ++s) c[s] = v.accumulated[s][pixel];
   if (v.length[pixel] < kDenoiseShortHistory) {
@@ -348,8 +351,9 @@ PVR_HOST_DEVICE inline bool refiningPixel(const DenoiseFrameView& v, size_t pixe
   return v.stillFrames > 0 && v.length[pixel] > 1.5f;
 }
 
-// The B3-spline's 1D weights at offsets -2..2.
-PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.375f : (i == 1 || i == -1) ? 0.25f : 0.0625f; }
+// The a-trous taps' 1D weights at offsets -1..1 (a 3x3 kernel: each pass doubles the step, so five
+// passes reach 31 samples across at a third of a 5x5 kernel's taps).
+PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.5f : 0.25f; }
 
 // A 3x3 Gaussian of the variance around the pixel over its own surface (the luminance test's
 // scale, less noisy; a noisier surface beside it does not loosen it).
@@ -372,9 +376,10 @@ PVR_HOST_DEVICE inline float blurredVariance(const ColourVariance* in, const Den
 
 // Step 4, a-trous pass `iteration` at pixel (x, y): reads filtered[s][iteration & 1], writes the
 // other one (and the history after the first pass); the last pass remodulates into `out`.
-PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int iteration, int x, int y) {
+template <int S>
+PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int iteration, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
-  const int signals = v.twoSignals();
+  constexpr int signals = S;
   const int from = iteration & 1, to = from ^ 1;
   const DenoiseGuide p = v.guide[pixel];
   const int spacing = denoiseSpacing(v, pixel);
@@ -390,8 +395,9 @@ PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int it
   Vec3 sum[2] = {Vec3(0.0f), Vec3(0.0f)};
   float variance[2] = {0, 0}, total[2] = {0, 0};
   const float lp[2] = {luminance(centre[0].colour), luminance(centre[1].colour)};
-  for (int j = -2; j <= 2; ++j)
-    for (int i = -2; i <= 2; ++i) {
+  const float sigma2 = v.params.sigmaLuminance * v.params.sigmaLuminance;
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) {
       const int qx = x + i * step, qy = y + j * step;
       if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
       const size_t q = denoisePixel(v.camera, qx, qy);
@@ -404,8 +410,8 @@ PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int it
         // The larger of the two variances scales the luminance test, so that two pixels weigh each
         // other alike: a dark pixel whose few samples happened to agree (a small variance) still
         // takes its bright neighbours' light, as they take its darkness, and the mean stays.
-        const float scale = v.params.sigmaLuminance * sqrtf(fmaxf(centreVariance[s], c.variance)) + 1e-6f;
-        const float w = self ? kernel : kernel * expf(-geometry - fabsf(luminance(c.colour) - lp[s]) / scale);
+        const float inverseScale = filterRsqrt(sigma2 * fmaxf(centreVariance[s], c.variance) + 1e-12f);
+        const float w = self ? kernel : kernel * filterExp(-geometry - fabsf(luminance(c.colour) - lp[s]) * inverseScale);
         sum[s] += c.colour * w;
         variance[s] += c.variance * w * w;
         total[s] += w;
@@ -418,22 +424,40 @@ PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int it
     if (iteration == 0 && !refiningPixel(v, pixel)) v.historyOut[s][pixel] = result[s];
   }
   if (iteration == v.params.iterations - 1) {
-    const Vec3 radiance = signals == 2 ? result[0].colour + result[1].colour : result[0].colour;
+    Vec3 radiance = result[0].colour;
+    if (signals == 2) radiance += result[signals - 1].colour;
     writeDenoised(v, pixel, radiance);
   }
 }
 
 // Step 5 without a-trous passes (iterations 0): the accumulated signals remodulated, and kept as
 // the history.
-PVR_HOST_DEVICE inline void remodulateAccumulated(const DenoiseFrameView& v, int x, int y) {
+template <int S>
+PVR_HOST_DEVICE inline void remodulateAccumulatedOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   Vec3 radiance{0, 0, 0};
-  for (int s = 0; s < v.twoSignals(); ++s) {
+  for (int s = 0; s < S; ++s) {
     const ColourVariance c = v.accumulated[s][pixel];
     v.historyOut[s][pixel] = c;
     radiance += c.colour;
   }
   writeDenoised(v, pixel, radiance);
+}
+
+PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, int x, int y) {
+  return v.twoSignals() == 2 ? accumulateDenoisePixelOf<2>(v, x, y) : accumulateDenoisePixelOf<1>(v, x, y);
+}
+PVR_HOST_DEVICE inline void estimateDenoiseVariance(const DenoiseFrameView& v, int x, int y) {
+  if (v.twoSignals() == 2) estimateDenoiseVarianceOf<2>(v, x, y);
+  else estimateDenoiseVarianceOf<1>(v, x, y);
+}
+PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int iteration, int x, int y) {
+  if (v.twoSignals() == 2) atrousDenoisePixelOf<2>(v, iteration, x, y);
+  else atrousDenoisePixelOf<1>(v, iteration, x, y);
+}
+PVR_HOST_DEVICE inline void remodulateAccumulated(const DenoiseFrameView& v, int x, int y) {
+  if (v.twoSignals() == 2) remodulateAccumulatedOf<2>(v, x, y);
+  else remodulateAccumulatedOf<1>(v, x, y);
 }
 
 }  // namespace pvr

@@ -52,9 +52,20 @@ struct EyePass {
   EyeCamera source;                          ///< the reuser's: the eye it reuses (the left)
   const FoveationMask* mask = nullptr;       ///< foveated: the mask, placed at the gaze pixel
   int gazeX = 0, gazeY = 0;
-  bool denoiseGuides = false;  ///< full resolution: also write what the denoiser needs (direct part, albedo, normal)
+  bool denoiseGuides = false;  ///< full resolution: also write the guides (emitted and direct parts, albedo, normal)
   int stillFrames = 0;         ///< frames the view has been still before this one (the denoiser's refinement)
   bool foveated() const { return mask != nullptr; }
+};
+
+// What the temporal stage resolves for one eye.
+struct TemporalPass {
+  Eye eye = Eye::Left;
+  EyeCamera camera;
+  TaaParams params;
+  bool foveated = false;
+  bool denoised = false;      ///< the denoised image (else the rendered one)
+  bool emittedApart = false;  ///< the eye pass wrote its guides: their emitted part is shown as rendered
+  bool reuser = false;        ///< the right eye under full-resolution reuse: reused pixels' emitted part is the left's
 };
 
 // What the pass reads of the eye it reuses, from that eye's buffers as the backend holds them
@@ -105,7 +116,7 @@ StageIO mapBuildIO();
 StageIO scatterIO();
 StageIO eyePassIO(const EyePass& pass);
 StageIO denoiseIO(const EyePass& pass);
-StageIO temporalIO(Eye eye, bool foveated, bool denoised);
+StageIO temporalIO(const TemporalPass& pass);
 
 // What has been written this frame.
 class FrameDataflow {
@@ -159,8 +170,7 @@ class FrameBackend {
   // reuse the right eye's reused pixels show the left eye's denoised colour.
   virtual void denoise(const EyePass& pass, const DenoiseParams& params) = 0;
   // Temporal: blends the eye's rendered (or denoised) image with its history into its displayed image.
-  virtual void resolveTemporal(Eye eye, const EyeCamera& camera, const TaaParams& params, bool foveated,
-                               bool denoised) = 0;
+  virtual void resolveTemporal(const TemporalPass& pass) = 0;
   virtual void forgetHistory(Eye eye) = 0;  ///< the next resolve starts again
   virtual void forgetDenoiseHistory(Eye eye) = 0;  ///< the next denoise starts again
   // Waits for the frame's work; the clock's times are valid after this.

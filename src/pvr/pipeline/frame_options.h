@@ -4,7 +4,7 @@
 #include <string>
 
 #include "pvr/camera/stereo_rig.h"
-#include "pvr/denoise/svgf.h"
+#include "pvr/denoise/denoise_options.h"
 #include "pvr/foveation/foveation_options.h"
 #include "pvr/photon/gather.h"
 #include "pvr/photon/photon_map.h"

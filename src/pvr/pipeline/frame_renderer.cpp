@@ -76,12 +76,17 @@ StageIO denoiseIO(const EyePass& pass) {
   return io;
 }
 
-StageIO temporalIO(Eye eye, bool foveated, bool denoised) {
-  const int e = int(eye);
+StageIO temporalIO(const TemporalPass& pass) {
+  const int e = int(pass.eye);
   StageIO io{Stage::Temporal,
-             {{denoised ? FrameData::DenoisedImage : FrameData::RenderedImage, e}, {FrameData::InverseDepth, e}},
+             {{pass.denoised ? FrameData::DenoisedImage : FrameData::RenderedImage, e}, {FrameData::InverseDepth, e}},
              {{FrameData::DisplayedImage, e}}};
-  if (foveated) io.reads.push_back({FrameData::SampleSpacing, e});
+  if (pass.foveated) io.reads.push_back({FrameData::SampleSpacing, e});
+  if (pass.emittedApart) io.reads.push_back({FrameData::DenoiseGuides, e});
+  if (pass.reuser) {
+    io.reads.push_back({FrameData::ReusedFrom, e});
+    io.reads.push_back({FrameData::DenoiseGuides, int(Eye::Left)});
+  }
   return io;
 }
 
@@ -204,7 +209,8 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
     pass.gather = options.gather;
     pass.map = options.map;
     pass.kernel = options.kernel;
-    pass.denoiseGuides = options.denoise.enabled;
+    // TAA keeps the emitted part out of its history; the denoiser also needs the rest.
+    pass.denoiseGuides = options.denoise.enabled || options.temporal.enabled;
     pass.stillFrames = stillFrames_;
     pass.role = !reusing ? StereoRole::Alone : eye == Eye::Left ? StereoRole::Source : StereoRole::Reuser;
     if (pass.role == StereoRole::Reuser) {
@@ -242,9 +248,17 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
       backend.forgetHistory(eye);
       continue;
     }
-    flow.run(temporalIO(eye, pass.foveated(), options.denoise.enabled));
+    TemporalPass resolve;
+    resolve.eye = eye;
+    resolve.camera = pass.camera;
+    resolve.params = options.temporal.taa;
+    resolve.foveated = pass.foveated();
+    resolve.denoised = options.denoise.enabled;
+    resolve.emittedApart = pass.denoiseGuides && !pass.foveated();
+    resolve.reuser = resolve.emittedApart && pass.role == StereoRole::Reuser;
+    flow.run(temporalIO(resolve));
     StageScope scope(clock, Stage::Temporal, e);
-    backend.resolveTemporal(eye, pass.camera, options.temporal.taa, pass.foveated(), options.denoise.enabled);
+    backend.resolveTemporal(resolve);
   }
 
   const FrameCounters counters = backend.finishFrame();

@@ -7,10 +7,16 @@
 //    current frame;
 //  - clamped to the colour range of the pixel's current neighbourhood, so that what changed
 //    (moving light, a mirror's reflection) does not leave a ghost.
+// What was emitted along a pixel's path (a light or the sky seen, directly or in a mirror) has no
+// noise and is rendered at the pixel centre as the reference is, so where the eye pass reports it
+// it is shown as rendered and kept out of the history: resampling a moving head's history mixes
+// neighbours, and beside a light (tens of times its neighbours' radiance, inside their clamp range)
+// that mix compounds frame after frame into a bright rim.
 // Foveated frames are reconstructed from samples several pixels apart in the periphery; the
 // neighbourhood there is scaled to the local sample spacing, so it spans neighbouring samples as
 // a 3x3 neighbourhood does at full resolution.
 #include "pvr/camera/stereo_rig.h"
+#include "pvr/stereo/stereo_reuse.h"
 
 namespace pvr {
 
@@ -27,16 +33,38 @@ struct TemporalOptions {
   TaaParams taa;
 };
 
+// The current frame's emitted part per pixel (null: not known; all of the image is resolved).
+// Under stereo reuse a reused pixel's is the left eye's at the pixel it reused.
+struct TaaEmitted {
+  const Vec3* emitted = nullptr;
+  const uint32_t* reusedFrom = nullptr;
+  const Vec3* sourceEmitted = nullptr;
+};
+
 // One eye's frame and its history, as device or host pointers.
 struct TaaView {
   EyeCamera camera, previousCamera;
   const Vec3* current = nullptr;
   const float* inverseDepth = nullptr;   ///< current frame, per pixel (0: nothing hit)
   const float* sampleSpacing = nullptr;  ///< current frame, pixels between samples; null: 1
-  const Vec3* history = nullptr;         ///< previous displayed frame (previousCamera's size); null: none
+  const Vec3* history = nullptr;         ///< previous resolved frame (previousCamera's size); null: none
   const float* historyInverseDepth = nullptr;
+  TaaEmitted emission;
   TaaParams params;
 };
+
+// The emitted part of the current frame's pixel (zero where it is not known).
+PVR_HOST_DEVICE inline Vec3 emittedAt(const TaaView& v, size_t pixel) {
+  const TaaEmitted& e = v.emission;
+  if (!e.emitted) return Vec3(0.0f);
+  const uint32_t source = e.reusedFrom ? e.reusedFrom[pixel] : kNotReused;
+  return source != kNotReused ? e.sourceEmitted[source] : e.emitted[pixel];
+}
+
+// What the history accumulates of the current frame's pixel: all of it but the emitted part.
+PVR_HOST_DEVICE inline Vec3 resolvedPart(const TaaView& v, size_t pixel) {
+  return v.emission.emitted ? max(v.current[pixel] - emittedAt(v, pixel), Vec3(0.0f)) : v.current[pixel];
+}
 
 // Pixel (x, y) of a colour or depth image, the nearest edge pixel outside it.
 template <class T>
@@ -141,10 +169,11 @@ PVR_HOST_DEVICE inline bool previousSawSameSurface(const TaaView& v, float px, f
 PVR_HOST_DEVICE inline void neighbourhoodRange(const TaaView& v, int x, int y, Vec3& lo, Vec3& hi) {
   const int w = v.camera.width, h = v.camera.height;
   const int step = sampleStep(v, x, y);
-  lo = hi = v.current[size_t(y) * w + x];
+  lo = hi = resolvedPart(v, size_t(y) * w + x);
   for (int j = -1; j <= 1; ++j)
     for (int i = -1; i <= 1; ++i) {
-      Vec3 c = clampedPixel(v.current, w, h, x + i * step, y + j * step);
+      const int qx = x + i * step, qy = y + j * step;
+      const Vec3 c = resolvedPart(v, size_t(qy < 0 ? 0 : qy >= h ? h - 1 : qy) * w + (qx < 0 ? 0 : qx >= w ? w - 1 : qx));
       lo = min(lo, c);
       hi = max(hi, c);
     }
@@ -153,17 +182,27 @@ PVR_HOST_DEVICE inline void neighbourhoodRange(const TaaView& v, int x, int y, V
 // Reprojected positions this close to a pixel centre read that pixel exactly.
 constexpr float kTaaSnapPixels = 2e-3f;
 
-// The displayed colour of pixel (x, y); `usedHistory` says whether the history contributed
-// (false: first frame, disocclusion, or the point was off the previous image).
-PVR_HOST_DEVICE inline Vec3 resolveTemporalPixel(const TaaView& v, int x, int y, bool& usedHistory) {
+// One pixel's resolve: what the history keeps and what is displayed (the same but for the emitted
+// part, added back), and whether the history contributed (false: first frame, disocclusion, or
+// the point was off the previous image).
+struct TaaPixel {
+  Vec3 history{0, 0, 0};
+  Vec3 displayed{0, 0, 0};
+  bool usedHistory = false;
+};
+
+PVR_HOST_DEVICE inline TaaPixel resolveTemporalPixel(const TaaView& v, int x, int y) {
   const size_t pixel = size_t(y) * v.camera.width + x;
-  const Vec3 current = v.current[pixel];
-  usedHistory = false;
-  if (!v.history) return current;
+  const Vec3 current = resolvedPart(v, pixel);
+  const Vec3 emitted = emittedAt(v, pixel);
+  TaaPixel out;
+  out.history = current;
+  out.displayed = v.current[pixel];
+  if (!v.history) return out;
   float px, py, expected;
   if (!reprojectToPrevious(v, x, y, px, py, expected) ||
       !previousSawSameSurface(v, px, py, expected, sampleStep(v, x, y)))
-    return current;
+    return out;
   // A still head reprojects onto the pixel centres up to float rounding (about 1e-4 pixel); read
   // those pixels as they are, or Catmull-Rom mixes a rounding's worth of the neighbours in every
   // frame and the history settles off the image by that much times 1 / blend (at a light's edge).
@@ -177,8 +216,10 @@ PVR_HOST_DEVICE inline Vec3 resolveTemporalPixel(const TaaView& v, int x, int y,
   } else {
     history = max(history, Vec3(0.0f));  // Catmull-Rom's lobes can undershoot
   }
-  usedHistory = true;
-  return history + (current - history) * v.params.blend;
+  out.usedHistory = true;
+  out.history = history + (current - history) * v.params.blend;
+  out.displayed = out.history + emitted;
+  return out;
 }
 
 }  // namespace pvr

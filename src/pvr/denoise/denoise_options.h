@@ -1,0 +1,34 @@
+#pragma once
+// The denoise stage's options (the passes are in svgf.h): what a frame's options carry.
+
+namespace pvr {
+
+struct DenoiseParams {
+  int iterations = 5;            ///< a-trous passes (0: temporal accumulation only)
+  float colourAlpha = 0.2f;      ///< the current frame's least weight in the accumulated colour
+  float momentsAlpha = 0.2f;     ///< the same for the luminance moments
+  float sigmaLuminance = 4.0f;   ///< luminance edge-stopping, in local standard deviations
+  float normalPower = 128.0f;    ///< normal edge-stopping: exp(-power (1 - cos))
+  float depthTolerance = 0.02f;  ///< relative inverse-depth difference off the pixel's plane: another surface
+  // Progressive refinement while the head is still (within the tolerances below from the last
+  // frame): the frames' signals are averaged with 1 / n (not the moving head's alpha floor), new
+  // photons each frame with a radius shrinking by Knaus-Zwicker's rule (refineAlpha, down to
+  // minRadiusFraction of the first), and the filter fades out as the average's own variance
+  // falls, so the picture converges to the unbiased image. Any movement returns to the moving
+  // head's weights: the average's frame count halves each frame down to theirs, no pop.
+  bool refineWhenStill = true;
+  float stillPosition = 1e-3f;      ///< head movement (scene units) that still counts as still
+  float stillAngleDegrees = 0.05f;  ///< head rotation that still counts as still
+  float refineAlpha = 0.7f;
+  float minRadiusFraction = 0.25f;
+};
+
+// The denoise stage's options.
+struct DenoiseOptions {
+  bool enabled = false;
+  DenoiseParams params;
+};
+
+constexpr int kMaxDenoiseIterations = 8;
+
+}  // namespace pvr
