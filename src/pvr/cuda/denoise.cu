@@ -54,6 +54,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   next.length.reserve(pixels, "denoiser history length");
   next.guide.reserve(pixels, "denoiser guides");
   state.albedo.reserve(pixels, "denoiser albedo");
+  state.depthGradient.reserve(2 * pixels, "denoiser depth gradient");
   state.out.reserve(pixels, "denoised image");
   historyPixels_.reserve(2, "denoiser history count");
 
@@ -70,6 +71,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
     v.history.guide = previous.guide.data();
   }
   v.albedo = state.albedo.data();
+  v.depthGradient = state.depthGradient.data();
   v.guide = next.guide.data();
   v.moments = next.moments.data();
   v.length = next.length.data();
@@ -106,7 +108,7 @@ void GpuDenoiser::downloadHistoryPixels(unsigned host[2], cudaStream_t stream) c
 size_t GpuDenoiser::memoryBytes() const {
   size_t bytes = historyPixels_.bytes();
   for (const EyeState& s : eyes_) {
-    bytes += s.history[0].bytes() + s.history[1].bytes() + s.albedo.bytes() + s.out.bytes();
+    bytes += s.history[0].bytes() + s.history[1].bytes() + s.albedo.bytes() + s.depthGradient.bytes() + s.out.bytes();
     for (int k = 0; k < 2; ++k) bytes += s.accumulated[k].bytes() + s.filtered[k][0].bytes() + s.filtered[k][1].bytes();
   }
   return bytes;

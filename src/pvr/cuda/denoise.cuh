@@ -31,6 +31,7 @@ class GpuDenoiser {
     bool valid = false;
     EyeCamera camera;
     DeviceBuffer<Vec3> albedo, out;
+    DeviceBuffer<float> depthGradient;
     DeviceBuffer<ColourVariance> accumulated[2], filtered[2][2];
   };
   EyeState eyes_[2];

@@ -38,6 +38,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   next.length.resize(pixels);
   next.guide.resize(pixels);
   state.albedo.resize(pixels);
+  state.depthGradient.resize(2 * pixels);
   out = Image(camera.width, camera.height);
 
   DenoiseFrameView v;
@@ -53,6 +54,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
     v.history.guide = previous.guide.data();
   }
   v.albedo = state.albedo.data();
+  v.depthGradient = state.depthGradient.data();
   v.guide = next.guide.data();
   v.moments = next.moments.data();
   v.length = next.length.data();

@@ -30,6 +30,7 @@ class HostDenoiser {
     bool valid = false;
     EyeCamera camera;
     std::vector<Vec3> albedo;
+    std::vector<float> depthGradient;
     std::vector<ColourVariance> accumulated[2], filtered[2][2];
   };
   EyeState eyes_[2];

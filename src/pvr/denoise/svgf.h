@@ -90,6 +90,7 @@ struct DenoiseFrameView {
   ColourVariance* accumulated[2] = {nullptr, nullptr};
   float* moments = nullptr;                        ///< becomes the history's
   float* length = nullptr;                         ///< becomes the history's
+  float* depthGradient = nullptr;                  ///< 2 per pixel: the inverse depth's gradient (x, y), per pixel
   ColourVariance* filtered[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};  ///< a-trous ping-pong per signal
   ColourVariance* historyOut[2] = {nullptr, nullptr};  ///< the first pass's output: the next frame's history
   Vec3* out = nullptr;                             ///< the denoised image
@@ -227,6 +228,8 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
   demodulatedInputs(v, pixel, signal, albedo, guide);
   v.albedo[pixel] = albedo;
   v.guide[pixel] = guide;
+  inverseDepthGradient(v.in.inverseDepth, v.camera, x, y, denoiseSpacing(v, pixel), v.depthGradient[2 * pixel],
+                       v.depthGradient[2 * pixel + 1]);
   float moments[4];
   for (int s = 0; s < 2; ++s) {
     const float l = luminance(signal[s]);
@@ -312,8 +315,7 @@ PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v,
   if (v.length[pixel] < kDenoiseShortHistory) {
     const DenoiseGuide p = v.guide[pixel];
     const int step = denoiseSpacing(v, pixel);
-    float gx, gy;
-    inverseDepthGradient(v.in.inverseDepth, v.camera, x, y, step, gx, gy);
+    const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
     float sum[4] = {0, 0, 0, 0}, total = 0.0f;
     for (int j = -3; j <= 3; ++j)
       for (int i = -3; i <= 3; ++i) {
@@ -384,13 +386,14 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
   const DenoiseGuide p = v.guide[pixel];
   const int spacing = denoiseSpacing(v, pixel);
   const int step = spacing << iteration;
-  float gx, gy;
-  inverseDepthGradient(v.in.inverseDepth, v.camera, x, y, spacing, gx, gy);
+  const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
   ColourVariance centre[2], result[2];
   float centreVariance[2];
   for (int s = 0; s < signals; ++s) {
     centre[s] = v.filtered[s][from][pixel];
-    centreVariance[s] = blurredVariance(v.filtered[s][from], v, p, gx, gy, x, y, spacing);
+    // The first pass's variance is the noisy estimate of one frame's moments: blurred over the
+    // surface first. The later passes' have been filtered by the earlier passes already.
+    centreVariance[s] = iteration == 0 ? blurredVariance(v.filtered[s][from], v, p, gx, gy, x, y, spacing) : centre[s].variance;
   }
   Vec3 sum[2] = {Vec3(0.0f), Vec3(0.0f)};
   float variance[2] = {0, 0}, total[2] = {0, 0};
