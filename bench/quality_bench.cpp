@@ -41,24 +41,39 @@ Pose swayAndTurn(const Pose& start, int frame) {
 struct Variant {
   const char* name;
   bool denoise, taa;
+  int photonBatches;  ///< a rolling photon map's slices (1: every photon every frame)
+  bool freshNoise = true;  ///< new random numbers every frame (the default under TAA or the denoiser)
 };
-constexpr Variant kVariants[] = {
-    {"raw", false, false}, {"TAA", false, true}, {"denoise", true, false}, {"denoise + TAA", true, true}};
+constexpr Variant kVariants[] = {{"raw", false, false, 1},
+                                 {"TAA", false, true, 1},
+                                 {"denoise", true, false, 1},
+                                 {"denoise + TAA", true, true, 1},
+                                 {"denoise, rolling 8", true, false, 8},
+                                 {"denoise + TAA, rolling 8", true, true, 8},
+                                 {"denoise, rolling 16", true, false, 16},
+                                 {"denoise, same noise", true, false, 1, false}};
 
 // Flicker of shown frames a -> b where the reference does not change: the mean absolute change of
 // luminance over the pixels whose references differ by less than 2 % (and 0.002 absolute), over
-// the references' mean luminance there. Also how many pixels counted.
-double flicker(const Image& a, const Image& b, const Image& referenceA, const Image& referenceB, size_t& counted) {
-  double change = 0, level = 0;
-  counted = 0;
+// the references' mean luminance there. Those pixels still change a little in the reference (a
+// moving head sees a slightly different view): that floor, and the change the reference does not
+// explain (mean |(b - a) - (reference b - reference a)|), come with it.
+struct Flicker {
+  double shown = 0, reference = 0, unexplained = 0;
+};
+Flicker flicker(const Image& a, const Image& b, const Image& referenceA, const Image& referenceB) {
+  double shown = 0, truth = 0, unexplained = 0, level = 0;
   for (size_t i = 0; i < a.pixels.size(); ++i) {
     const double ra = luminance(referenceA.pixels[i]), rb = luminance(referenceB.pixels[i]);
     if (std::fabs(ra - rb) > 0.02 * std::max(ra, rb) + 0.002) continue;
-    change += std::fabs(double(luminance(a.pixels[i])) - luminance(b.pixels[i]));
+    const double d = double(luminance(b.pixels[i])) - luminance(a.pixels[i]);
+    shown += std::fabs(d);
+    truth += std::fabs(rb - ra);
+    unexplained += std::fabs(d - (rb - ra));
     level += 0.5 * (ra + rb);
-    ++counted;
   }
-  return level > 0 ? change / level : 0.0;
+  if (level <= 0) return {};
+  return {shown / level, truth / level, unexplained / level};
 }
 
 // Mean absolute change of luminance from a to b over a's mean luminance.
@@ -104,7 +119,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
               "a shadow ray to every light, pixel centres; 4x the passes for the still head).\n"
               "Moving head: a 2 s sway-and-turn at %d Hz (%d frames), relMSE averaged over %zu sampled frames of "
               "both eyes, flicker (mean |change| of luminance between consecutive frames where the reference does "
-              "not change, over its mean there) over %zu pairs. Still head: %d frames (5 s) at the first pose.\n\n",
+              "not change, over its mean there; beside it the reference's own change there, and the change the "
+              "reference does not explain: mean |shown change - reference change|) over %zu pairs. Still head: %d frames (5 s) at the first pose.\n\n",
               args.referencePasses, kHz, kMovingFrames, 2 * std::size(kSampledPairs), std::size(kSampledPairs),
               kStillFrames);
   for (const std::string& name : splitList(args.qualityScenes)) {
@@ -164,15 +180,18 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
     }
     std::printf("| %s | %dx%d per eye | radius %g | references: %zu views, estimated relMSE (variance) at most %.2g |\n\n",
                 scene.name.c_str(), start.width, start.height, o.gather.density.radius, sampled.size(), worstEstimate);
-    std::printf("| scene | variant | relMSE (moving) | of raw | SSIM | flicker | of raw | denoise ms / stereo frame (mean / p99) | "
-                "frame ms (mean / p99) | check |\n|---|---|---|---|---|---|---|---|---|---|\n");
-    double rawRelMse = 0, rawFlicker = 0;
+    std::printf("| scene | variant | relMSE (moving) | of raw | SSIM | flicker | of raw | reference's flicker | "
+                "flicker the reference does not explain | of raw | denoise ms / stereo frame (mean / p99) | "
+                "frame ms (mean / p99) | check |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    double rawRelMse = 0, rawFlicker = 0, rawUnexplained = 0;
     for (const Variant& v : kVariants) {
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
       RenderOptions vo = o;
       vo.denoise.enabled = v.denoise;
       vo.temporal.enabled = v.taa;
-      std::vector<double> denoiseMs, frameMs, relMse, ssim, flickers;
+      vo.photonBatches = v.photonBatches;
+      renderer->setFreshNoisePerFrame(v.freshNoise);
+      std::vector<double> denoiseMs, frameMs, relMse, ssim, flickers, referenceFlickers, unexplained;
       std::vector<std::array<Image, 2>> shown(sampled.size());
       for (int f = 0; f < kMovingFrames; ++f) {
         StereoRig rig = start;
@@ -190,35 +209,41 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
           ssim.push_back(err.ssim);
         }
       }
-      size_t counted = 0;
       for (size_t s = 0; s + 1 < sampled.size(); s += 2)
-        for (int e = 0; e < 2; ++e)
-          flickers.push_back(flicker(shown[s][e], shown[s + 1][e], references[s][e], references[s + 1][e], counted));
-      const double m = mean(relMse), fl = mean(flickers);
-      if (!v.denoise && !v.taa) rawRelMse = m, rawFlicker = fl;
+        for (int e = 0; e < 2; ++e) {
+          const Flicker f = flicker(shown[s][e], shown[s + 1][e], references[s][e], references[s + 1][e]);
+          flickers.push_back(f.shown), referenceFlickers.push_back(f.reference), unexplained.push_back(f.unexplained);
+        }
+      const double m = mean(relMse), fl = mean(flickers), un = mean(unexplained);
+      if (!v.denoise && !v.taa) rawRelMse = m, rawFlicker = fl, rawUnexplained = un;
       const LatencyStats dn = latencyStats(denoiseMs), fr = latencyStats(frameMs);
       // Every variant must stay near the reference (a broken path shows here), and the denoiser
       // must bring the image closer than the raw frame.
       const bool ok = m < 1.0 && (!v.denoise || m < rawRelMse);
       failures += ok ? 0 : 1;
-      std::printf("| %s | %s | %.5f | %.3f | %.3f | %.4f | %.3f | %s | %s | %s |\n", scene.name.c_str(), v.name, m,
-                  rawRelMse > 0 ? m / rawRelMse : 1.0, mean(ssim), fl, rawFlicker > 0 ? fl / rawFlicker : 1.0,
-                  v.denoise ? meanP99(dn, 3).c_str() : "-", meanP99(fr, 2).c_str(), ok ? "ok" : "MISMATCH");
+      std::printf("| %s | %s | %.5f | %.3f | %.3f | %.4f | %.3f | %.4f | %.4f | %.3f | %s | %s | %s |\n",
+                  scene.name.c_str(), v.name, m, rawRelMse > 0 ? m / rawRelMse : 1.0, mean(ssim), fl,
+                  rawFlicker > 0 ? fl / rawFlicker : 1.0, mean(referenceFlickers), un,
+                  rawUnexplained > 0 ? un / rawUnexplained : 1.0, v.denoise ? meanP99(dn, 3).c_str() : "-", meanP99(fr, 2).c_str(), ok ? "ok" : "MISMATCH");
       if (!args.qualityImages.empty()) {
         const std::string prefix = args.qualityImages + "_" + scene.name + "_moving_";
         std::string tag = v.name;
         std::replace(tag.begin(), tag.end(), ' ', '_');
         std::replace(tag.begin(), tag.end(), '+', 'p');
+        tag.erase(std::remove(tag.begin(), tag.end(), ','), tag.end());
         writePng(centreCrop(shown[2][0], kCrop), prefix + tag + ".png");
         if (!v.denoise && !v.taa) writePng(centreCrop(references[2][0], kCrop), prefix + "reference.png");
       }
       json.push_back({{"suite", "quality"}, {"scene", scene.name}, {"head", "moving"}, {"variant", v.name},
-                      {"backend", renderer->name()}, {"device", renderer->deviceName()},
+                      {"photon_batches", v.photonBatches}, {"backend", renderer->name()}, {"device", renderer->deviceName()},
                       {"eye_size", {start.width, start.height}}, {"photons", 512 * 512},
                       {"radius", o.gather.density.radius}, {"frames", kMovingFrames}, {"sampled_frames", sampled},
                       {"rel_mse_vs_reference", m}, {"rel_mse_of_raw", rawRelMse > 0 ? m / rawRelMse : 1.0},
                       {"ssim_vs_reference", mean(ssim)}, {"flicker", fl},
-                      {"flicker_of_raw", rawFlicker > 0 ? fl / rawFlicker : 1.0}, {"denoise_ms", dn},
+                      {"flicker_of_raw", rawFlicker > 0 ? fl / rawFlicker : 1.0},
+                      {"reference_flicker", mean(referenceFlickers)}, {"unexplained_flicker", un},
+                      {"unexplained_flicker_of_raw", rawUnexplained > 0 ? un / rawUnexplained : 1.0},
+                      {"fresh_noise", v.freshNoise}, {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});
     }
@@ -232,6 +257,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                 "|---|---|---|---|---|---|---|---|---|---|\n");
     for (const Variant& v : kVariants) {
       if (v.taa && !v.denoise) continue;  // TAA alone is the moving head's business
+      // A still head retraces every photon each frame anyway, and refines with new numbers.
+      if (v.photonBatches > 1 || !v.freshNoise) continue;
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
       RenderOptions vo = o;
       vo.denoise.enabled = v.denoise;

@@ -70,6 +70,9 @@ expect_error "--no-refine is for --denoise" render cornell --no-refine --eye-siz
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations 9 --eye-size 8x8
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations -1 --eye-size 8x8
 expect_error "--denoise-iterations" render cornell --denoise --denoise-iterations two --eye-size 8x8
+expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photon-batches 0 --eye-size 8x8
+expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photon-batches 65 --eye-size 8x8
+expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photons 4x4 --photon-batches 32 --eye-size 8x8
 expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty
 expect_error "--reference-passes must be between 2" bench --suite quality --reference-passes 1 --backend cpu
 expect_error "--suite must be" bench --suite speed

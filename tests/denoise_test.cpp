@@ -463,3 +463,82 @@ TEST(DenoiseFrames, ReusedPixelsShowTheLeftEyesDenoisedColour) {
 
 }  // namespace
 }  // namespace pvr
+
+namespace pvr {
+namespace {
+
+RenderOptions rollingOptions(int batches) {
+  RenderOptions o;
+  o.eyes[1] = false;
+  o.photonsX = o.photonsY = 64;
+  o.photonBatches = batches;
+  o.gather.mode = ShadingMode::PhotonMapOnly;  // the image changes only with the photons
+  o.temporal.enabled = true;                   // new random numbers every frame ...
+  o.temporal.taa.blend = 1.0f;                 // ... and the displayed image is the rendered one
+  return o;
+}
+
+StereoRig rollingRig(const Scene& scene) {
+  StereoRig rig = scene.rig;
+  rig.width = 48, rig.height = 54;
+  return rig;
+}
+
+// With the seed's numbers in every frame, the slices together are exactly the full photon map:
+// the same photons, in the same order, and the same image bit for bit.
+TEST(RollingPhotons, TheSlicesOfOneSeedAreTheFullMap) {
+  Scene scene = builtinScene("cornell");
+  const StereoRig rig = rollingRig(scene);
+  FrameRenderer whole = makeCpuFrameRenderer(scene), rolling = makeCpuFrameRenderer(scene);
+  whole.setFreshNoisePerFrame(false), rolling.setFreshNoisePerFrame(false);
+  for (int frame = 0; frame < 6; ++frame) {
+    const FrameResult a = whole.render(rig, rollingOptions(1)), b = rolling.render(rig, rollingOptions(4));
+    EXPECT_EQ(a.storedPhotons, b.storedPhotons) << "frame " << frame;
+    EXPECT_EQ(a.eyes[0].image.pixels, b.eyes[0].image.pixels) << "frame " << frame;
+  }
+}
+
+// With new numbers every frame, consecutive rolling maps share all but one slice: the photon
+// map's image changes about sqrt(1/8) as much from frame to frame as when every photon is new,
+// and its level stays.
+TEST(RollingPhotons, ConsecutiveFramesShareAllButOneSlice) {
+  Scene scene = builtinScene("cornell");
+  const StereoRig rig = rollingRig(scene);
+  double change[2] = {0, 0}, level[2] = {0, 0};
+  const int batches[2] = {1, 8};
+  for (int v = 0; v < 2; ++v) {
+    FrameRenderer r = makeCpuFrameRenderer(scene);
+    Image previous;
+    for (int frame = 0; frame < 12; ++frame) {
+      const Image image = r.render(rig, rollingOptions(batches[v])).eyes[0].image;
+      for (const Vec3& c : image.pixels) level[v] += luminance(c);
+      if (frame > 0)
+        for (size_t i = 0; i < image.pixels.size(); ++i)
+          change[v] += std::fabs(double(luminance(image.pixels[i])) - luminance(previous.pixels[i]));
+      previous = image;
+    }
+  }
+  std::printf("frame-to-frame change of the photon map's image: %.4g with 8 slices, %.4g with all photons new (%.3f)\n",
+              change[1], change[0], change[1] / change[0]);
+  EXPECT_LT(change[1], 0.6 * change[0]);
+  EXPECT_GT(change[1], 0.2 * change[0]) << "a slice must be retraced every frame";
+  EXPECT_NEAR(level[1] / level[0], 1.0, 0.03);
+}
+
+// A change of the photons' options retraces every slice at once: no frame mixes two settings.
+TEST(RollingPhotons, AChangeOfPhotonsRetracesEverySlice) {
+  Scene scene = builtinScene("cornell");
+  const StereoRig rig = rollingRig(scene);
+  FrameRenderer r = makeCpuFrameRenderer(scene);
+  r.setFreshNoisePerFrame(false);
+  RenderOptions fewer = rollingOptions(4), more = rollingOptions(4);
+  fewer.temporal.enabled = more.temporal.enabled = false;  // the image as rendered, bit for bit
+  more.photonsX = more.photonsY = 96;
+  for (int frame = 0; frame < 3; ++frame) r.render(rig, fewer);
+  FrameRenderer fresh = makeCpuFrameRenderer(scene);
+  fresh.setFreshNoisePerFrame(false);
+  EXPECT_EQ(r.render(rig, more).eyes[0].image.pixels, fresh.render(rig, more).eyes[0].image.pixels);
+}
+
+}  // namespace
+}  // namespace pvr

@@ -333,6 +333,29 @@ TEST(GpuBackend, DenoisingMatchesTheCpu) {
   }
 }
 
+// A rolling photon map (one slice of four retraced per frame, new numbers every frame) on both
+// backends: the same photons and images frame after frame.
+TEST(GpuBackend, RollingPhotonMapMatchesTheCpu) {
+  PVR_REQUIRE_GPU();
+  BothBackends both("cornell-caustics", 320, 352);
+  auto& [scene, rig, cpu, gpu] = both;
+  RenderOptions o = comparisonOptions();
+  o.photonBatches = 4;
+  o.denoise.enabled = true;
+  cpu.resetHistory();
+  gpu.resetHistory();
+  const Pose start = rig.head;
+  for (int f = 0; f < 6; ++f) {
+    rig.head.position = start.toWorldPoint({0.02f * f, 0.0f, -0.02f * f});
+    FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
+    const std::string what = "frame " + std::to_string(f);
+    EXPECT_NEAR(double(b.storedPhotons) / double(a.storedPhotons), 1.0, 1e-3) << what;
+    for (int e = 0; e < 2; ++e)
+      EXPECT_LT(relativeDifference(a.eyes[e].image.pixels, b.eyes[e].image.pixels), 0.01) << what << ", eye " << e;
+  }
+  rig.head = start;
+}
+
 TEST(GpuBackend, RayTraversalAgreesWithEmbree) {
   PVR_REQUIRE_GPU();
   for (const char* name : {"cornell", "cornell-caustics"}) {

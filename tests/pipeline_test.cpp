@@ -24,7 +24,7 @@ class RecordingBackend : public FrameBackend {
   std::string name() const override { return "recording"; }
   std::string deviceName() const override { return "none"; }
   StageClock& clock() override { return clock_; }
-  size_t tracePhotons(const PhotonTraceParams&) override { return record("trace"), 0; }
+  size_t tracePhotons(const PhotonTraceParams&, int, int) override { return record("trace"), 0; }
   size_t buildPhotonMap(PhotonMapKind, float) override { return record("build"), 0; }
   void scatter(const EyeCamera&, const EyeCamera&) override { record("scatter"); }
   void renderEye(const EyePass& pass) override {

@@ -93,6 +93,7 @@ struct RenderArgs {
   bool denoise = false;
   int denoiseIterations = DenoiseParams().iterations;
   bool noRefine = false;
+  int photonBatches = 1;     // a rolling photon map's slices, one retraced per frame
   std::string out = "out/render";
   float exposure = 1.0f;
   std::string acuity = "linear";  // the mask made at start under --foveated
@@ -199,6 +200,10 @@ void addDenoiseOptions(CLI::App& cmd, RenderArgs& a) {
                "accumulated over frames by reprojection, filtered by an edge-aware a-trous wavelet");
   cmd.add_option("--denoise-iterations", a.denoiseIterations,
                  "A-trous passes of --denoise (0: temporal accumulation only; at most 8)")
+      ->capture_default_str();
+  cmd.add_option("--photon-batches", a.photonBatches,
+                 "A rolling photon map: the photons in N slices, one retraced per frame, so consecutive frames share "
+                 "all but one (less flicker under --denoise or --taa; 1..64, 1: all photons every frame)")
       ->capture_default_str();
   cmd.add_flag("--no-refine", a.noRefine,
                "With --denoise: no progressive refinement while the head is still (averaging still frames with a "
@@ -317,6 +322,7 @@ std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
   options.denoise.params.refineWhenStill = !a.noRefine;
   options.denoise.enabled = a.denoise;
   options.denoise.params.iterations = a.denoiseIterations;
+  options.photonBatches = a.photonBatches;
   validateOptions(options, rig);  // all of them, before any work
   if (!a.trajectory.empty()) setup->trajectory = loadTrajectory(a.trajectory);
   if (scene.skippedTriangles() > 0)

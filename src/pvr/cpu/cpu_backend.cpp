@@ -14,8 +14,9 @@ std::vector<Photon> CpuBackend::tracePhotons(const PhotonTraceParams& params) co
   const uint32_t slots = uint32_t(std::max(params.maxDepth, 1));
   std::vector<Photon> scratch(size_t(chunk) * slots);
   std::vector<int> counts(chunk);
-  for (uint32_t first = 0; first < params.photonCount; first += chunk) {
-    uint32_t n = std::min(chunk, params.photonCount - first);
+  const uint32_t last = params.lastPhoton();
+  for (uint32_t first = params.firstPhoton; first < last; first += chunk) {
+    uint32_t n = std::min(chunk, last - first);
     parallelFor("photon trace", n, 256, [&](size_t begin, size_t end) {
       for (uint32_t i = uint32_t(begin); i < uint32_t(end); ++i)
         counts[i] = tracePhoton(view, intersector_, params, first + i, &scratch[size_t(i) * slots]);

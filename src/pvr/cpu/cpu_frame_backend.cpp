@@ -18,8 +18,16 @@ std::string CpuFrameBackend::deviceName() const {
   return model + ", " + std::to_string(tbb::info::default_concurrency()) + " threads";
 }
 
-size_t CpuFrameBackend::tracePhotons(const PhotonTraceParams& params) {
-  photons_ = backend_.tracePhotons(params);
+size_t CpuFrameBackend::tracePhotons(const PhotonTraceParams& params, int slot, int slots) {
+  if (slots == 1) {
+    photonSlots_.clear();
+    photons_ = backend_.tracePhotons(params);
+    return photons_.size();
+  }
+  if (int(photonSlots_.size()) != slots) photonSlots_.assign(size_t(slots), {});
+  photonSlots_[size_t(slot)] = backend_.tracePhotons(params);
+  photons_.clear();
+  for (const std::vector<Photon>& s : photonSlots_) photons_.insert(photons_.end(), s.begin(), s.end());
   return photons_.size();
 }
 

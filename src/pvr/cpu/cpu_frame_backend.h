@@ -18,7 +18,7 @@ class CpuFrameBackend : public FrameBackend {
   std::string deviceName() const override;
   StageClock& clock() override { return clock_; }
 
-  size_t tracePhotons(const PhotonTraceParams& params) override;
+  size_t tracePhotons(const PhotonTraceParams& params, int slot, int slots) override;
   size_t buildPhotonMap(PhotonMapKind kind, float radius) override;
   void scatter(const EyeCamera& source, const EyeCamera& target) override;
   void renderEye(const EyePass& pass) override;
@@ -45,7 +45,8 @@ class CpuFrameBackend : public FrameBackend {
 
   CpuBackend backend_;
   HostStageClock clock_;
-  std::vector<Photon> photons_;
+  std::vector<Photon> photons_;                   ///< what the map is built over
+  std::vector<std::vector<Photon>> photonSlots_;  ///< a rolling map's slices (empty: one trace)
   PhotonMapKind mapKind_ = PhotonMapKind::HashGrid;
   HashGrid grid_;
   KdTree tree_;

@@ -32,6 +32,11 @@ struct CudaFrameBackend::Impl {
   cudaDeviceProp properties{};
   cuda::DeviceScene deviceScene;
   cuda::GpuPhotonTracer tracer;
+  cuda::RollingPhotons rolling;
+  bool rollingInUse = false;  ///< the map is built over the rolling slices, not the last trace
+  const Photon* mapPhotons() const { return rollingInUse ? rolling.photons() : tracer.photons(); }
+  uint32_t mapPhotonCount() const { return rollingInUse ? rolling.count() : tracer.count(); }
+  const Bounds3& mapBounds() const { return rollingInUse ? rolling.bounds() : tracer.bounds(); }
   cuda::GpuHashGrid grid;
   cuda::GpuKdTree tree;
   PhotonMapKind mapKind = PhotonMapKind::HashGrid;
@@ -118,21 +123,25 @@ size_t CudaFrameBackend::deviceBytes() const { return cuda::deviceBytesInUse(); 
 const cuda::DeviceScene& CudaFrameBackend::deviceScene() const { return impl_->deviceScene; }
 CUstream_st* CudaFrameBackend::stream() const { return impl_->stream; }
 
-size_t CudaFrameBackend::tracePhotons(const PhotonTraceParams& params) {
+size_t CudaFrameBackend::tracePhotons(const PhotonTraceParams& params, int slot, int slots) {
   Impl& m = *impl_;
   m.frame = Impl::FrameState();
-  return m.tracer.trace(m.deviceScene, params, m.stream);
+  const uint32_t traced = m.tracer.trace(m.deviceScene, params, m.stream);
+  m.rollingInUse = slots > 1;
+  if (!m.rollingInUse) return traced;
+  m.rolling.store(slot, slots, m.tracer.photons(), traced, m.tracer.bounds(), m.stream);
+  return m.rolling.count();
 }
 
 size_t CudaFrameBackend::buildPhotonMap(PhotonMapKind kind, float radius) {
   Impl& m = *impl_;
   m.mapKind = kind;
   if (kind == PhotonMapKind::HashGrid) {
-    m.grid.build(m.tracer.photons(), m.tracer.count(), m.tracer.bounds(), radius, m.stream);
+    m.grid.build(m.mapPhotons(), m.mapPhotonCount(), m.mapBounds(), radius, m.stream);
     m.gridView = m.grid.view();
     return m.grid.memoryBytes();
   }
-  m.tree.build(m.tracer.photons(), m.tracer.count(), m.stream);  // on the host: the stage's events span it
+  m.tree.build(m.mapPhotons(), m.mapPhotonCount(), m.stream);  // on the host: the stage's events span it
   m.treeView = m.tree.view();
   return m.tree.memoryBytes();
 }

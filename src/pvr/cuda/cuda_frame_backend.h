@@ -36,7 +36,7 @@ class CudaFrameBackend : public FrameBackend {
   std::string deviceName() const override;
   StageClock& clock() override;
 
-  size_t tracePhotons(const PhotonTraceParams& params) override;
+  size_t tracePhotons(const PhotonTraceParams& params, int slot, int slots) override;
   size_t buildPhotonMap(PhotonMapKind kind, float radius) override;
   void scatter(const EyeCamera& source, const EyeCamera& target) override;
   void renderEye(const EyePass& pass) override;

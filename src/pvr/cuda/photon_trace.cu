@@ -66,8 +66,10 @@ size_t GpuPhotonTracer::memoryBytes() const {
 uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParams& params, cudaStream_t stream) {
   const int slotsPerPhoton = std::max(params.maxDepth, 1);
   // Chunks bound the scratch slots to 256 MiB whatever the photon count and depth.
-  const uint32_t chunk =
-      uint32_t(std::clamp<uint64_t>((uint64_t(256) << 20) / (sizeof(Photon) * slotsPerPhoton), 1024, params.photonCount));
+  const uint32_t last = params.lastPhoton();
+  const uint32_t traced = last > params.firstPhoton ? last - params.firstPhoton : 0;
+  const uint32_t chunk = uint32_t(
+      std::clamp<uint64_t>((uint64_t(256) << 20) / (sizeof(Photon) * slotsPerPhoton), 1024, std::max<uint32_t>(traced, 1024)));
   slots_.reserve(size_t(chunk) * slotsPerPhoton, "photon scratch slots");
   counts_.reserve(size_t(chunk) + 1, "photon counts");
   offsets_.reserve(size_t(chunk) + 1, "photon offsets");
@@ -80,8 +82,8 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
   for (int a = 0; a < 3; ++a) init[a] = orderedFromFloat(INFINITY), init[3 + a] = orderedFromFloat(-INFINITY);
   PVR_CUDA_CHECK(cudaMemcpyAsync(summary_.data(), init, sizeof init, cudaMemcpyHostToDevice, stream));
   uint32_t stored = 0;
-  for (uint32_t first = 0; first < params.photonCount; first += chunk) {
-    uint32_t n = std::min(chunk, params.photonCount - first);
+  for (uint32_t first = params.firstPhoton; first < last; first += chunk) {
+    uint32_t n = std::min(chunk, last - first);
     PVR_CUDA_CHECK(cudaMemsetAsync(counts_.data() + n, 0, sizeof(uint32_t), stream));
     launch("photon trace", tracePhotonsKernel, blocksFor(n, kPhotonBlock), kPhotonBlock, 0, stream, scene.view, scene.intersector, params,
            first, n, slots_.data(), counts_.data(), summary_.data());
@@ -110,6 +112,38 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
     bounds_.upper = {floatFromOrdered(hostSummary_[3]), floatFromOrdered(hostSummary_[4]), floatFromOrdered(hostSummary_[5])};
   }
   return stored;
+}
+
+void RollingPhotons::store(int slot, int slots, const Photon* photons, uint32_t count, const Bounds3& bounds,
+                           cudaStream_t stream) {
+  if (int(slices_.size()) != slots) slices_ = std::vector<Slice>(size_t(slots));
+  Slice& s = slices_[size_t(slot)];
+  s.photons.reserve(std::max<size_t>(size_t(count) * 5 / 4, 1024), "rolling photon slice");
+  if (count)
+    PVR_CUDA_CHECK(cudaMemcpyAsync(s.photons.data(), photons, count * sizeof(Photon), cudaMemcpyDeviceToDevice, stream));
+  s.count = count;
+  s.bounds = bounds;
+  size_t total = 0;
+  bounds_ = Bounds3();
+  for (const Slice& x : slices_) {
+    total += x.count;
+    if (x.count) bounds_.extend(x.bounds.lower), bounds_.extend(x.bounds.upper);
+  }
+  all_.reserve(std::max<size_t>(total * 5 / 4, 1024), "rolling photon map");
+  size_t at = 0;
+  for (const Slice& x : slices_) {
+    if (x.count)
+      PVR_CUDA_CHECK(cudaMemcpyAsync(all_.data() + at, x.photons.data(), x.count * sizeof(Photon), cudaMemcpyDeviceToDevice,
+                                     stream));
+    at += x.count;
+  }
+  count_ = uint32_t(total);
+}
+
+size_t RollingPhotons::memoryBytes() const {
+  size_t bytes = all_.bytes();
+  for (const Slice& x : slices_) bytes += x.photons.bytes();
+  return bytes;
 }
 
 }  // namespace pvr::cuda

@@ -1,6 +1,8 @@
 #pragma once
 // The photon-trace stage on the GPU: the shared tracePhoton per photon, the stored photons
 // compacted in photon-index order (the CPU backend's order, so the two compare element by element).
+#include <vector>
+
 #include "pvr/cuda/device_scene.cuh"
 
 namespace pvr::cuda {
@@ -24,6 +26,30 @@ class GpuPhotonTracer {
   DeviceBuffer<int> summary_;  ///< 6 ordered-int bounds
   DeviceBuffer<unsigned char> temp_;
   int* hostSummary_ = nullptr;  ///< pinned: bounds and the chunk's count
+  uint32_t count_ = 0;
+  Bounds3 bounds_;
+};
+
+// A rolling photon map's slices on the device, each the photons of one trace, and all of them in
+// one array for the map build (slice by slice, so in photon-index order when the slices are).
+class RollingPhotons {
+ public:
+  // Replaces slice `slot` of `slots` (a new slot count empties all) by `count` photons at
+  // `photons` (device) within `bounds`; reassembles the array.
+  void store(int slot, int slots, const Photon* photons, uint32_t count, const Bounds3& bounds, cudaStream_t stream);
+  const Photon* photons() const { return all_.data(); }
+  uint32_t count() const { return count_; }
+  const Bounds3& bounds() const { return bounds_; }
+  size_t memoryBytes() const;
+
+ private:
+  struct Slice {
+    DeviceBuffer<Photon> photons;
+    uint32_t count = 0;
+    Bounds3 bounds;
+  };
+  std::vector<Slice> slices_;
+  DeviceBuffer<Photon> all_;
   uint32_t count_ = 0;
   Bounds3 bounds_;
 };

@@ -21,10 +21,18 @@
 namespace pvr {
 
 struct PhotonTraceParams {
-  uint32_t photonCount = 256 * 256;  ///< emitted photons N
+  uint32_t photonCount = 256 * 256;  ///< emitted photons N (each carries 1/N of the power)
+  // The photons traced: indices [firstPhoton, firstPhoton + tracedPhotons) of the N (0: up to N).
+  // A rolling photon map traces a slice of them per frame.
+  uint32_t firstPhoton = 0;
+  uint32_t tracedPhotons = 0;
   uint32_t seed = 1;
   int maxDepth = 8;  ///< surface interactions per photon path
   bool storeDirect = false;  ///< also store L D photons (when the photon map alone shades)
+  PVR_HOST_DEVICE uint32_t lastPhoton() const {  ///< one past the last index traced
+    const uint32_t end = tracedPhotons ? firstPhoton + tracedPhotons : photonCount;
+    return end < photonCount ? end : photonCount;
+  }
 };
 
 // A uniform point on a disk of `radius` around `center` facing `frameNormal`, moved upstream

@@ -156,7 +156,10 @@ class FrameBackend {
   virtual StageClock& clock() = 0;
 
   // Photon trace: returns the number of photons stored.
-  virtual size_t tracePhotons(const PhotonTraceParams& params) = 0;
+  // Traces params' photons into slot `slot` of `slots`, replacing what it held (a new slot count
+  // empties them all); the photon map is built over every slot's photons. Returns how many
+  // photons all slots hold.
+  virtual size_t tracePhotons(const PhotonTraceParams& params, int slot, int slots) = 0;
   // Map build over the stored photons: returns the map's bytes.
   virtual size_t buildPhotonMap(PhotonMapKind kind, float radius) = 0;
   // Scatter: the source eye's surfaces into the target eye's image.

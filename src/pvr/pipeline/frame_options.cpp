@@ -31,6 +31,9 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
   if (uint64_t(o.photonsX) * o.photonsY > kMaxPhotons)
     throw OptionError(RenderOption::Photons, "too many photons: " + std::to_string(uint64_t(o.photonsX) * o.photonsY) +
                                                  " (at most " + std::to_string(kMaxPhotons) + ", 8192x8192)");
+  if (o.photonBatches < 1 || o.photonBatches > kMaxPhotonBatches || uint64_t(o.photonBatches) > uint64_t(o.photonsX) * o.photonsY)
+    throw OptionError(RenderOption::PhotonBatches, "the photon batches must be between 1 and " +
+                                                       std::to_string(kMaxPhotonBatches) + ", and at most the photons");
   if (o.maxPhotonDepth < 1 || o.maxPhotonDepth > kMaxPathDepth)
     throw OptionError(RenderOption::PhotonDepth, "the photon depth must be between 1 and " + std::to_string(kMaxPathDepth));
   const DensityParams& d = o.gather.density;

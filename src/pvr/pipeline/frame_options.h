@@ -29,6 +29,11 @@ const char* densityKernelName(DensityKernel k);  ///< "single" | "hybrid" | "sha
 struct RenderOptions {
   uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
   int maxPhotonDepth = 8;
+  // A rolling photon map: the N photons in this many slices, one retraced per frame (with new
+  // random numbers under TAA or the denoiser), so consecutive frames share all but one slice and
+  // the photon map's noise changes little from frame to frame. 1: every photon every frame. A
+  // still head's refinement, and any change of the photons' options, retrace them all.
+  int photonBatches = 1;
   PhotonMapKind map = PhotonMapKind::HashGrid;
   DensityKernel kernel = DensityKernel::Hybrid;
   GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
@@ -59,8 +64,10 @@ constexpr int kMaxShadowRays = 64;
 // line names its flag).
 enum class RenderOption : int {
   Photons, PhotonDepth, Radius, K, SamplesPerPixel, SpecularDepth, ShadowRays, EyeSize, Ipd, Kernel, Gaze, TaaBlend,
-  TaaDepthTolerance, Stereo, DenoiseIterations, DenoiseParameter,
+  TaaDepthTolerance, Stereo, DenoiseIterations, DenoiseParameter, PhotonBatches,
 };
+
+constexpr int kMaxPhotonBatches = 64;
 
 class OptionError : public Error {
  public:

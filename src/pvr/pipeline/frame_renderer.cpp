@@ -122,6 +122,12 @@ bool samePicture(const RenderOptions& a, const RenderOptions& b) {
   return same;
 }
 
+// Whether two frames' options trace the same photons (a rolling map may keep its slices).
+bool samePhotons(const RenderOptions& a, const RenderOptions& b) {
+  return a.photonsX == b.photonsX && a.photonsY == b.photonsY && a.maxPhotonDepth == b.maxPhotonDepth &&
+         a.gather.mode == b.gather.mode && a.gather.seed == b.gather.seed && a.photonBatches == b.photonBatches;
+}
+
 // Whether the head moved less than the tolerances between two rigs of the same eyes.
 bool stillView(const StereoRig& a, const StereoRig& b, const DenoiseParams& p) {
   if (a.width != b.width || a.height != b.height || a.ipd != b.ipd) return false;
@@ -185,7 +191,26 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
   flow.run(photonTraceIO());
   {
     StageScope scope(clock, Stage::PhotonTrace);
-    frame.storedPhotons = backend.tracePhotons(options.photonTraceParams());
+    // A rolling map retraces one slice a frame; all of them at first, after a change of the
+    // photons' options, and while refining (each still frame wants photons of its own).
+    const int slots = options.photonBatches;
+    const bool refill = !photonsHeld_ || stillFrames_ > 0 || !samePhotons(requested, lastPhotonOptions_);
+    const PhotonTraceParams params = options.photonTraceParams();
+    auto traceSlot = [&](int k) {
+      PhotonTraceParams slice = params;
+      slice.firstPhoton = uint32_t(uint64_t(params.photonCount) * uint64_t(k) / uint64_t(slots));
+      slice.tracedPhotons = uint32_t(uint64_t(params.photonCount) * uint64_t(k + 1) / uint64_t(slots)) - slice.firstPhoton;
+      return backend.tracePhotons(slice, k, slots);
+    };
+    if (refill) {
+      for (int k = 0; k < slots; ++k) frame.storedPhotons = traceSlot(k);
+      nextPhotonSlot_ = 0;
+    } else {
+      frame.storedPhotons = traceSlot(nextPhotonSlot_);
+      nextPhotonSlot_ = (nextPhotonSlot_ + 1) % slots;
+    }
+    photonsHeld_ = true;
+    lastPhotonOptions_ = requested;
   }
   flow.run(mapBuildIO());
   {

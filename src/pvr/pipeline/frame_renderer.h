@@ -57,6 +57,9 @@ class FrameRenderer {
   std::optional<StereoRig> lastRig_;  ///< the last frame's view and options: is this one still?
   RenderOptions lastOptions_;
   int stillFrames_ = 0;
+  bool photonsHeld_ = false;  ///< the backend holds photons traced for lastPhotonOptions_
+  RenderOptions lastPhotonOptions_;
+  int nextPhotonSlot_ = 0;    ///< the rolling map's slice retraced next
   uint32_t blendedFrames_ = 0;         ///< frames rendered with a temporal stage (the noise's frame number)
   bool rendered_[2] = {false, false};  ///< the last frame's
   EyeImage shown_[2] = {EyeImage::Rendered, EyeImage::Rendered};
