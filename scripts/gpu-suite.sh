@@ -2,7 +2,8 @@
 # The GPU suite, run on a GPU machine from a bundle of this build (made here by
 #   ../shared/gpu/bundle.sh .gpu build/photonvr build/tests/pvr_gpu_tests):
 # the CUDA-vs-CPU tests, every render mode and the GPU bad-input cases through the executable, and
-# compute-sanitizer (memcheck, racecheck, synccheck, initcheck) on representative render modes.
+# compute-sanitizer (memcheck, racecheck, synccheck, initcheck) on representative render modes
+# (TAA with scatter reuse, foveated gather, denoised with a rolling photon map).
 #   usage: scripts/gpu-suite.sh BUNDLE_DIR LOG_DIR [--no-sanitizer]
 # Prints one line per part and exits non-zero if any part failed; the logs go to LOG_DIR.
 set -u
@@ -37,6 +38,9 @@ if [ "${3:-}" != --no-sanitizer ] && command -v compute-sanitizer >/dev/null; th
       --trajectory tests/data/gaze_pursuit.traj
     part "sanitizer_${tool}_foveated" compute-sanitizer --tool "$tool" --error-exitcode 9 \
       "$bundle/photonvr" render cornell "${small[@]}" --foveated --stereo gather --taa --kernel sorted \
+      --trajectory tests/data/gaze_pursuit.traj
+    part "sanitizer_${tool}_denoised" compute-sanitizer --tool "$tool" --error-exitcode 9 \
+      "$bundle/photonvr" render cornell "${small[@]}" --denoise --photon-batches 4 --taa --stereo gather \
       --trajectory tests/data/gaze_pursuit.traj
   done
 fi
