@@ -237,6 +237,21 @@ TEST(FoveationMask, FileRoundTripAndBadFiles) {
   uint32_t huge = 0xfffffff0u;
   std::memcpy(&badIndex[badIndex.size() - 4], &huge, 4);
   EXPECT_THROW(loadFoveationMask(writeFile("index.pvrmask", badIndex)), Error);
+  // A header claiming the most vertices in a small file is refused from the file's size, before
+  // half a gigabyte is allocated (found by the fuzzer: it took over a second under ASan).
+  std::string hugeCount = bytes;
+  const uint32_t mostVertices = 1u << 26;
+  constexpr size_t kVertexCountOffset = 56;  // magic, version, size, tan/pixel, acuity (7 fields), radius
+  uint32_t stored;
+  std::memcpy(&stored, &hugeCount[kVertexCountOffset], 4);
+  ASSERT_EQ(stored, mask.offsets.size());
+  std::memcpy(&hugeCount[kVertexCountOffset], &mostVertices, 4);
+  try {
+    loadFoveationMask(writeFile("count.pvrmask", hugeCount));
+    ADD_FAILURE() << "a vertex count beyond the file's size was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("claims 67108864 vertices"), std::string::npos) << e.what();
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -14,7 +14,7 @@ small=(--backend cpu --eye-size 32x32 --photons 32x32 --out "$out/img")
 good=(2CylinderEngine-glTF-Binary/2CylinderEngine.glb BoxBadNormals-glTF-Binary/BoxBadNormals.glb
       BoxTexcoords-glTF/boxTexcoords.gltf BoxTextured-glTF-Binary/BoxTextured.glb BoxTextured-glTF-Embedded/BoxTextured.gltf
       BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf BoxTextured-glTF-techniqueWebGL/BoxTextured.gltf
-      BoxTextured-glTF/BoxTextured.gltf ClearCoat-glTF/ClearCoatTest.gltf IncorrectVertexArrays/Cube.gltf
+      BoxTextured-glTF/BoxTextured.gltf ClearCoat-glTF/ClearCoatTest.gltf
       IndexOutOfRange/IndexOutOfRange.gltf cameras/Cameras.gltf draco/2CylinderEngine.gltf
       textureTransform/TextureTransformTest.gltf)
 for f in "${good[@]}"; do
@@ -33,7 +33,8 @@ done
 "$exe" render "$models/BoxTextured-glTF/BoxTextured.gltf" "${small[@]}" 2>/dev/null | grep -q ", 1 textures;" ||
   { echo "FAIL: BoxTextured.gltf's texture file not loaded"; failures=$((failures + 1)); }
 
-broken=(BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb IndexOutOfRange/AllIndicesOutOfRange.gltf MissingBin/BoxTextured.gltf
+# IncorrectVertexArrays' views run past its 514-byte buffer: refused before assimp reads them.
+broken=(BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb IncorrectVertexArrays/Cube.gltf IndexOutOfRange/AllIndicesOutOfRange.gltf MissingBin/BoxTextured.gltf
         RecursiveNodes/RecursiveNodes.gltf SchemaFailures/sceneWrongType.gltf TestNoRootNode/NoScene.gltf
         TestNoRootNode/SceneWithoutNodes.gltf wrongTypes/badArray.gltf wrongTypes/badExtension.gltf wrongTypes/badNumber.gltf
         wrongTypes/badObject.gltf wrongTypes/badString.gltf wrongTypes/badUint.gltf)

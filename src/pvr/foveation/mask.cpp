@@ -176,6 +176,18 @@ FoveationMask loadFoveationMask(const std::string& path) {
   if (vertices < 3 || vertices > kMaxVertices || triangles == 0 || triangles > 2 * kMaxVertices)
     throw Error("mask file '" + path + "' is corrupt: " + std::to_string(vertices) + " vertices, " +
                 std::to_string(triangles) + " triangles");
+  // The counts must match the bytes left before anything is allocated: a corrupt header must not
+  // ask for gigabytes.
+  const std::streamoff here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff left = in.tellg() - here;
+  in.seekg(here);
+  const std::streamoff expected = std::streamoff(vertices) * std::streamoff(sizeof(MaskPoint)) +
+                                  std::streamoff(triangles) * 3 * std::streamoff(sizeof(uint32_t));
+  if (left < expected)
+    throw Error("mask file '" + path + "' is truncated: its header claims " + std::to_string(vertices) + " vertices and " +
+                std::to_string(triangles) + " triangles (" + std::to_string(expected) + " bytes), " +
+                std::to_string(left) + " bytes follow");
   mask.offsets.resize(vertices);
   mask.triangles.resize(size_t(triangles) * 3);
   if (!in.read(reinterpret_cast<char*>(mask.offsets.data()), std::streamsize(vertices * sizeof(MaskPoint))) ||

@@ -276,6 +276,110 @@ std::vector<GltfExtras> readGltfExtras(const std::string& path) {
   return out;
 }
 
+// Bytes a glTF accessor element takes: component size times component count.
+size_t gltfElementBytes(const nlohmann::json& accessor) {
+  static const std::pair<int, size_t> kComponents[] = {{5120, 1}, {5121, 1}, {5122, 2}, {5123, 2}, {5125, 4}, {5126, 4}};
+  static const std::pair<const char*, size_t> kTypes[] = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
+                                                          {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
+  size_t component = 0, count = 0;
+  for (auto [type, bytes] : kComponents)
+    if (accessor.value("componentType", 0) == type) component = bytes;
+  for (auto [name, n] : kTypes)
+    if (accessor.value("type", std::string()) == name) count = n;
+  return component * count;
+}
+
+// Debian's assimp 5.2 reads past a buffer when a glTF's accessors or buffer views claim more bytes
+// than the file holds (a heap overflow found by scripts/fuzz.sh). Such a file breaks the glTF
+// spec, so it is refused here, before assimp sees it, with the element at fault named.
+void checkGltfRanges(const std::string& path) {
+  using nlohmann::json;
+  namespace fs = std::filesystem;
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".gltf" && ext != ".glb") return;
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  auto malformed = [&](const std::string& why) { throw Error("malformed glTF '" + path + "': " + why); };
+  std::string text;
+  uint64_t binBytes = 0;  // the GLB's BIN chunk
+  if (ext == ".glb") {
+    auto u32 = [&](size_t at) {
+      uint32_t v;
+      std::memcpy(&v, bytes.data() + at, 4);
+      return v;
+    };
+    if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0 || bytes.compare(16, 4, "JSON") != 0)
+      malformed("no GLB header and JSON chunk");
+    const uint64_t jsonLength = u32(12);
+    if (20 + jsonLength > bytes.size()) malformed("the JSON chunk runs past the end of the file");
+    text = bytes.substr(20, jsonLength);
+    const uint64_t bin = 20 + ((jsonLength + 3) & ~uint64_t(3));
+    if (bin + 8 <= bytes.size() && bytes.compare(bin + 4, 4, std::string("BIN\0", 4)) == 0) {
+      binBytes = u32(bin);
+      if (bin + 8 + binBytes > bytes.size()) malformed("the BIN chunk runs past the end of the file");
+    }
+  } else {
+    text = std::move(bytes);
+  }
+  json doc = json::parse(text, nullptr, false);
+  if (doc.is_discarded() || !doc.is_object()) return;  // assimp reports unreadable JSON itself
+  auto array = [&](const char* key) { return doc.contains(key) && doc[key].is_array() ? doc[key] : json::array(); };
+  auto number = [](const json& o, const char* key, uint64_t fallback) {
+    return o.contains(key) && o[key].is_number_unsigned() ? o[key].get<uint64_t>() : fallback;
+  };
+  const json buffers = array("buffers"), views = array("bufferViews"), accessors = array("accessors");
+  std::vector<uint64_t> held(buffers.size(), 0);  // bytes each buffer really has
+  for (size_t b = 0; b < buffers.size(); ++b) {
+    const json& buffer = buffers[b];
+    if (!buffer.is_object()) malformed("buffer " + std::to_string(b) + " is not an object");
+    const uint64_t claimed = number(buffer, "byteLength", 0);
+    uint64_t have = claimed;
+    if (!buffer.contains("uri")) {
+      have = ext == ".glb" && b == 0 ? binBytes : 0;
+    } else if (buffer["uri"].is_string()) {
+      const std::string uri = buffer["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) == 0) {
+        const size_t comma = uri.find(',');
+        have = comma == std::string::npos ? 0 : (uri.size() - comma - 1) / 4 * 3;
+      } else {
+        std::error_code ec;
+        const auto size = fs::file_size(fs::path(path).parent_path() / uri, ec);
+        if (!ec) have = size;  // a missing file is assimp's to report
+      }
+    }
+    if (claimed > have)
+      malformed("buffer " + std::to_string(b) + " claims " + std::to_string(claimed) + " bytes, " +
+                std::to_string(have) + " are there");
+    held[b] = claimed;
+  }
+  std::vector<uint64_t> viewBytes(views.size(), 0);
+  for (size_t v = 0; v < views.size(); ++v) {
+    const json& view = views[v];
+    if (!view.is_object()) malformed("bufferView " + std::to_string(v) + " is not an object");
+    const uint64_t buffer = number(view, "buffer", ~uint64_t(0));
+    if (buffer >= held.size()) malformed("bufferView " + std::to_string(v) + " names no buffer");
+    const uint64_t offset = number(view, "byteOffset", 0), length = number(view, "byteLength", 0);
+    if (offset > held[buffer] || length > held[buffer] - offset)
+      malformed("bufferView " + std::to_string(v) + " runs past the end of buffer " + std::to_string(buffer));
+    viewBytes[v] = length;
+  }
+  for (size_t a = 0; a < accessors.size(); ++a) {
+    const json& accessor = accessors[a];
+    if (!accessor.is_object() || !accessor.contains("bufferView")) continue;  // sparse or all zeros
+    const uint64_t view = number(accessor, "bufferView", ~uint64_t(0));
+    if (view >= viewBytes.size()) malformed("accessor " + std::to_string(a) + " names no bufferView");
+    const uint64_t element = gltfElementBytes(accessor), count = number(accessor, "count", 0);
+    if (element == 0) malformed("accessor " + std::to_string(a) + " has an unknown componentType or type");
+    if (count == 0) continue;
+    const uint64_t stride = std::max<uint64_t>(number(views[view], "byteStride", 0), element);
+    const uint64_t offset = number(accessor, "byteOffset", 0);
+    if (count > viewBytes[view] / stride + 1 || offset > viewBytes[view] ||
+        (count - 1) * stride + element > viewBytes[view] - offset)
+      malformed("accessor " + std::to_string(a) + " reads past the end of bufferView " + std::to_string(view));
+  }
+}
+
 }  // namespace
 
 void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& options) {
@@ -288,6 +392,7 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
   if (ext.empty() || !importer.IsExtensionSupported(ext))
     throw Error("unsupported scene format '" + (ext.empty() ? std::string("(no extension)") : ext) + "' for '" + path +
                 "' (use .json, .gltf, .glb or .obj)");
+  checkGltfRanges(path);
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* as = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
                                                   aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Fuzzes photonvr's input parsers with libFuzzer (clang, ASan + UBSan, leaks checked): the JSON
+# scene format, mesh import (glTF/GLB/OBJ through assimp), foveation masks and trajectories.
+#   usage: scripts/fuzz.sh [SECONDS_PER_HARNESS (default 30)] [BUILD_DIR (default build-fuzz)]
+# Seeds: the project's test data and scenes, and Debian's assimp-testmodels (its glTF2 samples,
+# broken glTF2 files and invalid/ models). Prints one line per harness (executions, findings);
+# a finding's input lands in BUILD_DIR/artifacts/HARNESS/ and the script exits non-zero.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+# clang and its libFuzzer runtime (Debian 12: clang 14), on top of the build's dependencies.
+fuzz_packages=()
+for p in clang libclang-rt-14-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || fuzz_packages+=("$p")
+done
+if [ ${#fuzz_packages[@]} -gt 0 ]; then
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${fuzz_packages[@]}"
+fi
+seconds=${1:-30}
+build=${2:-build-fuzz}
+flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPVR_ENABLE_CUDA=OFF -DPVR_FUZZ=ON \
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+harnesses=(scene_json mesh mask trajectory)
+cmake --build "$build" -j"$(nproc)" --target "${harnesses[@]/#/pvr_fuzz_}" >/dev/null
+
+models=/usr/share/assimp/models
+seed() {  # harness, files...
+  local dir=$build/corpus/$1
+  shift
+  mkdir -p "$dir"
+  for f in "$@"; do [ -f "$f" ] && cp "$f" "$dir/$(echo "$f" | md5sum | cut -c1-12)-$(basename "$f")"; done
+  return 0
+}
+seed scene_json tests/data/*.json scenes/*.json
+seed mesh tests/data/*.obj tests/data/*.gltf $(find "$models/glTF2" $models/invalid $models/OBJ \
+  \( -name '*.gltf' -o -name '*.glb' -o -name '*.obj' \) -size -40k 2>/dev/null | sort)
+seed mask tests/fuzz/corpus/mask/*
+seed trajectory tests/data/*.traj
+export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
+export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0
+failures=0
+for h in "${harnesses[@]}"; do
+  mkdir -p "$build/artifacts/$h"
+  [ -d "tests/fuzz/regressions/$h" ] && seed "$h" tests/fuzz/regressions/"$h"/*
+  log=$build/fuzz_$h.log
+  rc=0
+  "$build/tests/pvr_fuzz_$h" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2560 -print_final_stats=1 \
+    -artifact_prefix="$build/artifacts/$h/" "$build/corpus/$h" >"$log" 2>&1 || rc=$?
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+  found=$(find "$build/artifacts/$h" -type f | wc -l)
+  echo "fuzz $h: $runs executions in ${seconds} s, corpus $(find "$build/corpus/$h" -type f | wc -l) inputs," \
+    "$found finding(s), exit $rc"
+  if [ "$rc" -ne 0 ] || [ "$found" -ne 0 ]; then
+    failures=$((failures + 1))
+    grep -m3 -E 'ERROR|SUMMARY|leak|timeout' "$log" || true
+  fi
+done
+[ $failures -eq 0 ]
