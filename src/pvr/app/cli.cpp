@@ -203,7 +203,8 @@ void addDenoiseOptions(CLI::App& cmd, RenderArgs& a) {
       ->capture_default_str();
   cmd.add_option("--photon-batches", a.photonBatches,
                  "A rolling photon map: the photons in N slices, one retraced per frame, so consecutive frames share "
-                 "all but one (less flicker under --denoise or --taa; 1..64, 1: all photons every frame)")
+                 "all but one (1/N of the photon tracing a frame; on the H200 it did not lower the flicker and "
+                 "raised the error, docs/denoising.md; 1..64, 1: all photons every frame)")
       ->capture_default_str();
   cmd.add_flag("--no-refine", a.noRefine,
                "With --denoise: no progressive refinement while the head is still (averaging still frames with a "

@@ -30,8 +30,9 @@ struct RenderOptions {
   uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
   int maxPhotonDepth = 8;
   // A rolling photon map: the N photons in this many slices, one retraced per frame (with new
-  // random numbers under TAA or the denoiser), so consecutive frames share all but one slice and
-  // the photon map's noise changes little from frame to frame. 1: every photon every frame. A
+  // random numbers under TAA or the denoiser), so consecutive frames share all but one slice:
+  // 1/N of the photon tracing a frame (measured: no less flicker, more error; docs/denoising.md).
+  // 1: every photon every frame. A
   // still head's refinement, and any change of the photons' options, retrace them all.
   int photonBatches = 1;
   PhotonMapKind map = PhotonMapKind::HashGrid;

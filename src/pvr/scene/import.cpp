@@ -23,6 +23,7 @@
 #include <cctype>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <assimp/Importer.hpp>
 #include <filesystem>
@@ -225,28 +226,11 @@ TextureTransform transformOf(const nlohmann::json& textureInfo) {
   return out;
 }
 
-std::vector<GltfExtras> readGltfExtras(const std::string& path) {
+std::vector<GltfExtras> readGltfExtras(const nlohmann::json& doc) {
   using nlohmann::json;
   std::vector<GltfExtras> out;
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext != ".gltf" && ext != ".glb") return out;
-  std::ifstream in(path, std::ios::binary);
-  std::string text;
-  if (ext == ".glb") {  // header (12 bytes), then the JSON chunk: length, type "JSON", bytes
-    char header[20];
-    if (!in.read(header, 20) || std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0) return out;
-    uint32_t length;
-    std::memcpy(&length, header + 12, 4);
-    if (length > (1u << 28)) return out;
-    text.resize(length);
-    if (!in.read(text.data(), length)) return out;
-  } else {
-    text.assign(std::istreambuf_iterator<char>(in), {});
-  }
   try {
-    json doc = json::parse(text);
-    if (!doc.contains("materials") || !doc["materials"].is_array()) return out;
+    if (!doc.is_object() || !doc.contains("materials") || !doc["materials"].is_array()) return out;
     for (const json& m : doc["materials"]) {
       GltfExtras e;
       if (!m.is_object()) {
@@ -289,21 +273,25 @@ size_t gltfElementBytes(const nlohmann::json& accessor) {
   return component * count;
 }
 
-// Debian's assimp 5.2 reads past a buffer when a glTF's accessors or buffer views claim more bytes
-// than the file holds (a heap overflow found by scripts/fuzz.sh). Such a file breaks the glTF
-// spec, so it is refused here, before assimp sees it, with the element at fault named.
-void checkGltfRanges(const std::string& path) {
-  using nlohmann::json;
-  namespace fs = std::filesystem;
-  std::string ext = fs::path(path).extension().string();
+// A .gltf's or .glb's JSON, parsed once for the range check and the extras (discarded when it
+// does not parse: assimp reports that itself), and the bytes of a GLB's BIN chunk.
+struct GltfFile {
+  nlohmann::json doc;
+  bool glb = false;
+  uint64_t binBytes = 0;
+};
+
+std::optional<GltfFile> readGltfFile(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext != ".gltf" && ext != ".glb") return;
+  if (ext != ".gltf" && ext != ".glb") return std::nullopt;
+  GltfFile file;
+  file.glb = ext == ".glb";
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), {});
-  auto malformed = [&](const std::string& why) { throw Error("malformed glTF '" + path + "': " + why); };
   std::string text;
-  uint64_t binBytes = 0;  // the GLB's BIN chunk
-  if (ext == ".glb") {
+  if (file.glb) {  // header (12 bytes), then the JSON chunk (length, "JSON", bytes), then BIN
+    auto malformed = [&](const std::string& why) { throw Error("malformed glTF '" + path + "': " + why); };
     auto u32 = [&](size_t at) {
       uint32_t v;
       std::memcpy(&v, bytes.data() + at, 4);
@@ -316,14 +304,24 @@ void checkGltfRanges(const std::string& path) {
     text = bytes.substr(20, jsonLength);
     const uint64_t bin = 20 + ((jsonLength + 3) & ~uint64_t(3));
     if (bin + 8 <= bytes.size() && bytes.compare(bin + 4, 4, std::string("BIN\0", 4)) == 0) {
-      binBytes = u32(bin);
-      if (bin + 8 + binBytes > bytes.size()) malformed("the BIN chunk runs past the end of the file");
+      file.binBytes = u32(bin);
+      if (bin + 8 + file.binBytes > bytes.size()) malformed("the BIN chunk runs past the end of the file");
     }
   } else {
     text = std::move(bytes);
   }
-  json doc = json::parse(text, nullptr, false);
+  file.doc = nlohmann::json::parse(text, nullptr, false);
+  return file;
+}
+
+// Debian's assimp 5.2 reads past a buffer when a glTF's accessors or buffer views claim more bytes
+// than the file holds (a heap overflow found by scripts/fuzz.sh). Such a file breaks the glTF
+// spec, so it is refused here, before assimp sees it, with the element at fault named.
+void checkGltfRanges(const GltfFile& file, const std::string& path) {
+  using nlohmann::json;
+  const json& doc = file.doc;
   if (doc.is_discarded() || !doc.is_object()) return;  // assimp reports unreadable JSON itself
+  auto malformed = [&](const std::string& why) { throw Error("malformed glTF '" + path + "': " + why); };
   auto array = [&](const char* key) { return doc.contains(key) && doc[key].is_array() ? doc[key] : json::array(); };
   auto number = [](const json& o, const char* key, uint64_t fallback) {
     return o.contains(key) && o[key].is_number_unsigned() ? o[key].get<uint64_t>() : fallback;
@@ -336,7 +334,7 @@ void checkGltfRanges(const std::string& path) {
     const uint64_t claimed = number(buffer, "byteLength", 0);
     uint64_t have = claimed;
     if (!buffer.contains("uri")) {
-      have = ext == ".glb" && b == 0 ? binBytes : 0;
+      have = file.glb && b == 0 ? file.binBytes : 0;
     } else if (buffer["uri"].is_string()) {
       const std::string uri = buffer["uri"].get<std::string>();
       if (uri.rfind("data:", 0) == 0) {
@@ -344,7 +342,7 @@ void checkGltfRanges(const std::string& path) {
         have = comma == std::string::npos ? 0 : (uri.size() - comma - 1) / 4 * 3;
       } else {
         std::error_code ec;
-        const auto size = fs::file_size(fs::path(path).parent_path() / uri, ec);
+        const auto size = std::filesystem::file_size(std::filesystem::path(path).parent_path() / uri, ec);
         if (!ec) have = size;  // a missing file is assimp's to report
       }
     }
@@ -392,7 +390,8 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
   if (ext.empty() || !importer.IsExtensionSupported(ext))
     throw Error("unsupported scene format '" + (ext.empty() ? std::string("(no extension)") : ext) + "' for '" + path +
                 "' (use .json, .gltf, .glb or .obj)");
-  checkGltfRanges(path);
+  const std::optional<GltfFile> gltf = readGltfFile(path);
+  if (gltf) checkGltfRanges(*gltf, path);
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* as = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
                                                   aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
@@ -406,7 +405,7 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
     throw Error("cannot read '" + path + "': the file is incomplete");
   std::vector<uint32_t> materialMap(as->mNumMaterials);
   TextureLoader textures(scene);
-  const std::vector<GltfExtras> gltfExtras = readGltfExtras(path);
+  const std::vector<GltfExtras> gltfExtras = gltf ? readGltfExtras(gltf->doc) : std::vector<GltfExtras>();
   const std::string folder = fs::path(path).parent_path().string();
   for (unsigned i = 0; i < as->mNumMaterials; ++i)
   {
