@@ -7,17 +7,8 @@
 # a finding's input lands in BUILD_DIR/artifacts/HARNESS/ and the script exits non-zero.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
 # clang and its libFuzzer runtime (Debian 12: clang 14), on top of the build's dependencies.
-fuzz_packages=()
-for p in clang libclang-rt-14-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || fuzz_packages+=("$p")
-done
-if [ ${#fuzz_packages[@]} -gt 0 ]; then
-  sudo_cmd=()
-  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${fuzz_packages[@]}"
-fi
+bash scripts/install-deps.sh clang libclang-rt-14-dev
 seconds=${1:-30}
 build=${2:-build-fuzz}
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs photonvr's build and test dependencies from Debian 12's packages.
-# Idempotent and non-interactive: packages already present are not touched.
+# Idempotent and non-interactive: packages already present are not touched. Extra packages a
+# script needs beyond the build's (scripts/fuzz.sh: clang) come as arguments.
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config
@@ -9,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libvulkan-dev mesa-vulkan-drivers libopenxr-dev libglfw3-dev libimgui-dev
   xvfb xauth assimp-testmodels
+  "$@"
 )
 missing=()
 for p in "${packages[@]}"; do
