@@ -39,6 +39,7 @@ struct Variant {
   PhotonMapKind map;
   Estimator estimator;
   DensityKernel kernel;
+  DensityScheme density = DensityScheme::PerPixel;  ///< ours: SurfaceCache (not the same image as the paper's)
 };
 
 struct Row {
@@ -52,7 +53,7 @@ struct Table {
   std::string title;
   std::vector<Variant> variants;  ///< the paper's columns, then ours
   std::vector<Row> rows;
-  // Columns that compute the same image as column 0 (checked), e.g. single vs hybrid.
+  // Per-pixel columns compute the same image as column 0 (checked), e.g. single vs hybrid.
   bool sameImage;
 };
 
@@ -60,27 +61,31 @@ std::vector<Table> paperTables() {
   const auto grid = PhotonMapKind::HashGrid, kd = PhotonMapKind::KdTree;
   const auto knn = Estimator::Knn, radius = Estimator::Radius;
   const auto hybrid = DensityKernel::Hybrid;
+  const auto cache = DensityScheme::SurfaceCache;
   std::vector<Table> t;
-  t.push_back({1, "kd-tree vs hash grid (kNN max-heap, hybrid kernel)",
-               {{"kd-tree", kd, knn, hybrid}, {"hash grid", grid, knn, hybrid}},
+  t.push_back({1, "kd-tree vs hash grid (kNN max-heap, hybrid kernel); ours: the surface cache",
+               {{"kd-tree", kd, knn, hybrid}, {"hash grid", grid, knn, hybrid}, {"hash grid + cache (ours)", grid, knn, hybrid, cache}},
                {{512, 0.02f, {10.80, 6.15}}, {512, 0.05f, {112.30, 84.50}}, {512, 0.1f, {470.31, 567.70}},
                 {256, 0.05f, {12.48, 7.05}}, {256, 0.1f, {67.91, 48.68}}, {256, 0.2f, {314.21, 419.63}},
                 {128, 0.05f, {3.58, 3.03}}, {128, 0.1f, {8.17, 5.73}}, {128, 0.2f, {38.81, 27.16}}},
                true});
-  t.push_back({2, "heap vs no heap (hash grid, hybrid kernel)",
-               {{"heap (kNN)", grid, knn, hybrid}, {"no heap (radius)", grid, radius, hybrid}},
+  t.push_back({2, "heap vs no heap (hash grid, hybrid kernel); ours: the surface cache",
+               {{"heap (kNN)", grid, knn, hybrid}, {"no heap (radius)", grid, radius, hybrid},
+                {"heap + cache (ours)", grid, knn, hybrid, cache}, {"no heap + cache (ours)", grid, radius, hybrid, cache}},
                {{512, 0.02f, {6.61, 3.27}}, {512, 0.05f, {84.87, 8.26}}, {512, 0.1f, {583.50, 23.16}},
                 {256, 0.05f, {7.53, 3.50}}, {256, 0.1f, {49.30, 6.54}}, {256, 0.2f, {414.93, 20.16}}},
                false});
-  t.push_back({3, "single vs hybrid kernel (hash grid, radius)",
-               {{"single", grid, radius, DensityKernel::Single}, {"hybrid", grid, radius, hybrid}},
+  t.push_back({3, "single vs hybrid kernel (hash grid, radius); ours: the surface cache",
+               {{"single", grid, radius, DensityKernel::Single}, {"hybrid", grid, radius, hybrid},
+                {"cache (ours)", grid, radius, hybrid, cache}},
                {{512, 0.05f, {7.59, 4.48}}, {512, 0.1f, {22.01, 10.46}}, {512, 0.2f, {77.92, 36.82}},
                 {256, 0.05f, {3.47, 2.85}}, {256, 0.1f, {6.39, 4.12}}, {256, 0.2f, {20.04, 10.55}}},
                true});
-  t.push_back({4, "without vs with shared memory (hash grid, radius, hybrid); ours: cell-sorted",
+  t.push_back({4, "without vs with shared memory (hash grid, radius, hybrid); ours: cell-sorted, the surface cache",
                {{"no shared memory", grid, radius, hybrid},
                 {"shared memory (Alg. 1)", grid, radius, DensityKernel::SharedMemory},
-                {"cell-sorted (ours)", grid, radius, DensityKernel::CellSorted}},
+                {"cell-sorted (ours)", grid, radius, DensityKernel::CellSorted},
+                {"cache (ours)", grid, radius, hybrid, cache}},
                {{512, 0.05f, {4.63, 4.95}}, {512, 0.1f, {11.86, 10.57}}, {512, 0.2f, {34.76, 32.01}},
                 {256, 0.05f, {2.82, 2.79}}, {256, 0.1f, {4.12, 4.25}}, {256, 0.2f, {10.52, 9.30}}},
                true});
@@ -196,11 +201,41 @@ RenderOptions tableOptions(const Row& row, const Variant& v, int k) {
   o.photonsX = o.photonsY = row.photons;
   o.map = v.map;
   o.kernel = v.kernel;
+  o.density = v.density;
   o.gather.mode = ShadingMode::PhotonMapOnly;  // the paper's formulation
   o.gather.density.radius = row.radius;
   o.gather.density.estimator = v.estimator;
   o.gather.density.k = k;
   return o;
+}
+
+// The view's converged reference for the tables' error columns: the same view for every row
+// (progressive photon mapping from r = 0.05, 1024x1024 photons a pass, pixel centres as the cells').
+struct ViewReference {
+  Image eyes[2];
+  double estimatedRelMse[2] = {0, 0};
+  int passes = 0;
+};
+ViewReference convergedReference(FrameRenderer& renderer, const StereoRig& rig, int passes) {
+  RenderOptions ro;
+  ro.photonsX = ro.photonsY = 1024;
+  ro.gather.density.radius = 0.05f;
+  ro.gather.punctualShadowRays = 0;  // no light-selection noise
+  ro.gather.seed = 0x5eed;           // independent of the cells' numbers
+  ReferenceSettings settings;
+  settings.boxFilter = false;
+  ProgressiveReference reference(renderer, rig, ro, settings);
+  for (int i = 0; i < passes; ++i) reference.addPass();
+  ViewReference v;
+  for (int e = 0; e < 2; ++e) v.eyes[e] = reference.image(Eye(e)), v.estimatedRelMse[e] = reference.estimatedRelMse(Eye(e));
+  v.passes = passes;
+  return v;
+}
+
+// The mean over both eyes of a frame's relMSE against the reference.
+double relMseOfFrame(const FrameResult& frame, const ViewReference& reference) {
+  return 0.5 * (compareToReference(frame.eyes[0].image, reference.eyes[0]).relMse +
+                compareToReference(frame.eyes[1].image, reference.eyes[1]).relMse);
 }
 
 int runTables(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& renderer, const StereoRig& rig,
@@ -211,60 +246,104 @@ int runTables(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& ren
     if (t != "1" && t != "2" && t != "3" && t != "4") throw Error("--tables takes numbers 1 to 4, got '" + t + "'");
     wanted.push_back(std::stoi(t));
   }
+  if (args.referencePasses < 2 || args.referencePasses > kMaxReferencePasses)
+    throw Error("--reference-passes must be between 2 and " + std::to_string(kMaxReferencePasses));
+  const ViewReference reference = convergedReference(renderer, rig, args.referencePasses);
   std::printf("\nPaper tables on %s (%s backend): scene %s, both eyes %dx%d, photon-map-only shading (the paper's), "
-              "kNN k=%d, %d timed frames per cell after %d warm-up frames.\n"
+              "kNN k=%d, %d timed frames per cell after %d warm-up frames; surface cache cells of %g x the radius.\n"
               "Frame = wall time of one stereo frame (photon trace + map build + both eyes), synchronized; stages "
               "by CUDA events. Times: mean / p99 over the timed frames (p99 by nearest rank: the max under 100 "
-              "frames). Paper = RTX 2060 SUPER, one view, mean.\n",
+              "frames). Paper = RTX 2060 SUPER, one view, mean. Speed-up = the paper's fastest cell of the row over "
+              "our fastest (mean; p99 in brackets). relMSE = mean of both eyes' against the view's converged "
+              "reference (%d progressive passes of 1024x1024 photons from r = 0.05, pixel centres; its estimated "
+              "relMSE %.1e / %.1e); each cache column's must be within 5%% of (or below) its per-pixel column's.\n",
               renderer.deviceName().c_str(), renderer.name().c_str(), scene.name.c_str(), rig.width, rig.height, args.k,
-              args.frames, args.warmup);
+              args.frames, args.warmup, double(kDefaultCacheCellFraction), reference.passes,
+              reference.estimatedRelMse[0], reference.estimatedRelMse[1]);
   for (const Table& table : paperTables()) {
     if (std::find(wanted.begin(), wanted.end(), table.number) == wanted.end()) continue;
     std::printf("\nTable %d: %s\n\n| photons | radius |", table.number, table.title.c_str());
     for (const Variant& v : table.variants) std::printf(" %s ms (mean / p99) |", v.name.c_str());
     for (size_t c = 0; c < 2; ++c) std::printf(" paper %s ms |", table.variants[c].name.c_str());
-    std::printf(" check |\n|---|---|");
-    for (size_t c = 0; c < table.variants.size() + 3; ++c) std::printf("---|");
+    std::printf(" speed-up | relMSE (columns in order) | check |\n|---|---|");
+    for (size_t c = 0; c < table.variants.size() + 5; ++c) std::printf("---|");
     std::printf("\n");
     std::string details;
     for (const Row& row : table.rows) {
       std::vector<CellResult> cells;
-      for (const Variant& v : table.variants)
+      std::vector<double> relMse;
+      for (const Variant& v : table.variants) {
         cells.push_back(timeCell(renderer, rig, tableOptions(row, v, args.k), args.warmup, args.frames));
+        relMse.push_back(relMseOfFrame(cells.back().last, reference));
+      }
       std::string check = "ok";
       double worst = 0;
       if (table.sameImage) {
-        for (size_t c = 1; c < cells.size(); ++c)
+        for (size_t c = 1; c < cells.size(); ++c) {
+          if (table.variants[c].density != DensityScheme::PerPixel) continue;
           for (int e = 0; e < 2; ++e) {
             ImageDiff d = compareImages(cells[0].last.eyes[e].image, cells[c].last.eyes[e].image);
             worst = std::max(worst, d.relativeMad);
             if (d.relativeMad > 0.005 || d.outlierFraction > 0.002) check = "MISMATCH";
           }
+        }
       }
       if (check != "ok") ++failures;
+      // Each cache column against the per-pixel column of the same map and estimator.
+      std::string errorCheck;
+      std::vector<double> errorRatio(cells.size(), 0.0);
+      for (size_t c = 0; c < cells.size(); ++c) {
+        const Variant& v = table.variants[c];
+        if (v.density == DensityScheme::PerPixel) continue;
+        for (size_t p = 0; p < cells.size(); ++p) {
+          const Variant& w = table.variants[p];
+          if (w.density != DensityScheme::PerPixel || w.map != v.map || w.estimator != v.estimator) continue;
+          errorRatio[c] = relMse[c] / std::max(relMse[p], 1e-30);
+          break;
+        }
+        char text[96];
+        std::snprintf(text, sizeof text, "%s%s x%.3f", errorCheck.empty() ? "" : ", ",
+                      errorRatio[c] <= 1.05 ? "error" : "ERROR WORSE", errorRatio[c]);
+        errorCheck += text;
+        if (cells[c].last.cacheUnplaced > 0) errorCheck += " (some points had no cell)";
+      }
+      double bestOurs = 1e30, bestOursP99 = 1e30, bestPaper = 1e30;
+      for (const CellResult& c : cells) bestOurs = std::min(bestOurs, c.frame.mean), bestOursP99 = std::min(bestOursP99, c.frame.p99);
+      for (double p : row.paperMs) bestPaper = std::min(bestPaper, p);
       std::printf("| %ux%u | %g |", row.photons, row.photons, row.radius);
       for (const CellResult& c : cells) std::printf(" %s |", meanP99(c.frame, 2).c_str());
       for (double p : row.paperMs) std::printf(" %.2f |", p);
-      if (table.sameImage) std::printf(" %s (%.1e) |\n", check.c_str(), worst);
-      else std::printf(" n/a |\n");
+      std::printf(" x%.1f (x%.1f) |", bestPaper / bestOurs, bestPaper / bestOursP99);
+      for (size_t c = 0; c < cells.size(); ++c) std::printf("%s%.4f", c ? " / " : " ", relMse[c]);
+      std::printf(" |");
+      if (table.sameImage) std::printf(" %s (%.1e)%s%s |\n", check.c_str(), worst, errorCheck.empty() ? "" : "; ", errorCheck.c_str());
+      else std::printf(" %s |\n", errorCheck.empty() ? "n/a" : errorCheck.c_str());
       for (size_t c = 0; c < cells.size(); ++c) {
         const CellResult& r = cells[c];
+        const bool cached = table.variants[c].density == DensityScheme::SurfaceCache;
         char line[1024];
         std::snprintf(line, sizeof line,
-                      "| %ux%u | %g | %s | %.2f / %.2f / %.2f / %.2f | %s | %s | %s | %s | %zu | %.1f | %.1f |\n",
+                      "| %ux%u | %g | %s | %.2f / %.2f / %.2f / %.2f | %s | %s | %s | %s | %zu | %.1f | %.1f | %.4f | %s |\n",
                       row.photons, row.photons, row.radius, table.variants[c].name.c_str(), r.frame.mean, r.frame.p50,
                       r.frame.p99, r.frame.max, meanP99(r.stages.trace, 3).c_str(), meanP99(r.stages.build, 3).c_str(),
                       meanP99(r.stages.rays, 2).c_str(), meanP99(r.stages.density, 2).c_str(), r.stored,
-                      r.mapBytes / 1048576.0, r.deviceBytes / 1048576.0);
+                      r.mapBytes / 1048576.0, r.deviceBytes / 1048576.0, relMse[c],
+                      cached ? std::to_string(r.last.cacheCells).c_str() : "-");
         details += line;
         nlohmann::json cell = {
             {"table", table.number}, {"photons", row.photons * row.photons}, {"photons_grid", row.photons},
-            {"radius", row.radius}, {"variant", table.variants[c].name}, {"frame_ms", r.frame.mean},
+            {"radius", row.radius}, {"variant", table.variants[c].name},
+            {"density", densitySchemeName(table.variants[c].density)}, {"frame_ms", r.frame.mean},
             {"trace_ms", r.stages.trace.mean}, {"build_ms", r.stages.build.mean}, {"eye_rays_ms", r.stages.rays.mean},
             {"density_ms", r.stages.density.mean}, {"stored_photons", r.stored}, {"map_bytes", r.mapBytes},
-            {"device_bytes", r.deviceBytes},
+            {"device_bytes", r.deviceBytes}, {"rel_mse_vs_reference", relMse[c]},
+            {"reference_passes", reference.passes},
             {"paper_ms", c < row.paperMs.size() ? nlohmann::json(row.paperMs[c]) : nlohmann::json()},
-            {"check", table.sameImage ? check : "n/a"}};
+            {"check", table.sameImage && !cached ? check : "n/a"}};
+        if (cached)
+          cell.update({{"cache_cells", r.last.cacheCells}, {"cache_unplaced_points", r.last.cacheUnplaced},
+                       {"cache_cell_fraction", kDefaultCacheCellFraction}, {"error_vs_per_pixel", errorRatio[c]},
+                       {"error_check", errorRatio[c] <= 1.05 ? "ok" : "worse"}});
         cell.update(r.latencyJson());
         json.push_back(cell);
       }
@@ -273,8 +352,8 @@ int runTables(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& ren
     std::printf("\nTable %d per stage (ms per stereo frame over %d timed frames; frame: mean / p50 / p99 / max, "
                 "stages: mean / p99; eye rays and density summed over both eyes):\n\n"
                 "| photons | radius | variant | frame (mean / p50 / p99 / max) | trace | build | eye rays | density | "
-                "stored | map MiB | GPU MiB |\n"
-                "|---|---|---|---|---|---|---|---|---|---|---|\n%s",
+                "stored | map MiB | GPU MiB | relMSE | cache cells |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n%s",
                 table.number, args.frames, details.c_str());
   }
   return failures;

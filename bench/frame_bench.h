@@ -30,7 +30,7 @@ struct FrameBenchArgs {
   std::string eyeSize;  ///< empty: the scene's rig (1440x1600)
   std::string scenes = "scenes/dabrovic-sponza.json,scenes/sibenik.json,cornell-dense";  ///< scenes suite (cornell-dense: the per-ray yardstick); absent meshes: skipped
   float sceneRadius = 0.15f;  ///< scenes suite: the search radius, scene units
-  int referencePasses = 64;   ///< scenes and quality suites: passes of the progressive reference (1024x1024 photons each)
+  int referencePasses = 64;   ///< tables, scenes and quality suites: passes of the progressive reference (1024x1024 photons each)
   std::string qualityScenes = "cornell,scenes/dabrovic-sponza.json";  ///< quality suite
   std::string qualityImages;  ///< quality suite: PNG prefix (empty: none)
   int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)

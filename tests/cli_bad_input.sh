@@ -73,6 +73,10 @@ expect_error "--denoise-iterations" render cornell --denoise --denoise-iteration
 expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photon-batches 0 --eye-size 8x8
 expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photon-batches 65 --eye-size 8x8
 expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photons 4x4 --photon-batches 32 --eye-size 8x8
+expect_error "--density must be pixel or cache" render cornell --backend cpu --density fast "${small[@]}"
+expect_error "--cache-cell: the surface cache's cell must be between" render cornell --backend cpu --density cache --cache-cell 2 "${small[@]}"
+expect_error "--cache-cell: the surface cache's cell must be between" render cornell --backend cpu --density cache --cache-cell nan "${small[@]}"
+expect_error "--density: the surface cache shades full-resolution eyes" render cornell --backend cpu --density cache --foveated "${small[@]}"
 expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty
 expect_error "--reference-passes must be between 2" bench --suite quality --reference-passes 1 --backend cpu
 expect_error "--suite must be" bench --suite speed

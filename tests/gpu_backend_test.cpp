@@ -356,6 +356,33 @@ TEST(GpuBackend, RollingPhotonMapMatchesTheCpu) {
   rig.head = start;
 }
 
+// The surface cache (both eyes into one cache, the right eye under gather reuse too): the GPU
+// makes the same cells as the CPU (a few differ where a hit point's float position falls on a
+// cell boundary) and the same image.
+TEST(GpuBackend, SurfaceCacheMatchesTheCpu) {
+  PVR_REQUIRE_GPU();
+  for (const char* name : {"cornell", "cornell-caustics"})
+    for (StereoMode stereo : {StereoMode::Separate, StereoMode::Gather})
+      for (Estimator estimator : {Estimator::Radius, Estimator::Knn}) {
+        BothBackends both(name, 256, 288);
+        auto& [scene, rig, cpu, gpu] = both;
+        RenderOptions o = comparisonOptions();
+        o.density = DensityScheme::SurfaceCache;
+        o.stereo = stereo;
+        o.gather.density.estimator = estimator;
+        o.gather.mode = ShadingMode::PhotonMapOnly;  // every pixel's light through the cache
+        FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
+        const std::string what = std::string(name) + ", " + stereoModeName(stereo) +
+                                 (estimator == Estimator::Knn ? ", kNN" : ", radius");
+        ASSERT_GT(a.cacheCells, 100u) << what;
+        EXPECT_EQ(a.cacheUnplaced, 0u) << what;
+        EXPECT_EQ(b.cacheUnplaced, 0u) << what;
+        EXPECT_NEAR(double(b.cacheCells) / double(a.cacheCells), 1.0, 0.01) << what;
+        for (int e = 0; e < 2; ++e)
+          EXPECT_LT(relativeDifference(a.eyes[e].image.pixels, b.eyes[e].image.pixels), 0.01) << what << ", eye " << e;
+      }
+}
+
 TEST(GpuBackend, RayTraversalAgreesWithEmbree) {
   PVR_REQUIRE_GPU();
   for (const char* name : {"cornell", "cornell-caustics"}) {

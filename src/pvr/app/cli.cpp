@@ -72,6 +72,8 @@ struct RenderArgs {
   std::string map = "hashgrid";
   std::string estimator = "radius";
   std::string kernel = "hybrid";
+  std::string density = "pixel";
+  std::string cacheCell;  // empty: kDefaultCacheCellFraction
   std::string backend = "auto";
   std::string stereo = "separate";
   int k = 32;
@@ -127,6 +129,8 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     text("map", "--map", a.map);
     text("estimator", "--estimator", a.estimator);
     text("kernel", "--kernel", a.kernel);
+    text("density", "--density", a.density);
+    text("cache_cell", "--cache-cell", a.cacheCell);
     text("backend", "--backend", a.backend);
     text("stereo", "--stereo", a.stereo);
     text("eye_size", "--eye-size", a.eyeSize);
@@ -177,6 +181,12 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
                  "GPU eye pass: single (rays + estimate in one kernel) | hybrid (separate density kernel) | shared "
                  "(hybrid, the paper's Algorithm 1) | sorted (hybrid, gather points sorted by cell); same image")
       ->capture_default_str();
+  cmd.add_option("--density", a.density,
+                 "Photon-map estimates: pixel (one per gather point, the paper's) | cache (one per surface cell of "
+                 "side --cache-cell x radius, interpolated by the pixels and eyes near it; glossy points per pixel)")
+      ->capture_default_str();
+  cmd.add_option("--cache-cell", a.cacheCell, "The surface cache's cell side as a fraction of the radius (0.01..1, "
+                                              "default 0.25)");
   cmd.add_option("--backend", a.backend, "cpu (Embree + TBB reference) | cuda | auto (cuda if a GPU is present)")
       ->capture_default_str();
   cmd.add_option("--stereo", a.stereo,
@@ -247,6 +257,10 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   else if (a.kernel == "shared") o.kernel = DensityKernel::SharedMemory;
   else if (a.kernel == "sorted") o.kernel = DensityKernel::CellSorted;
   else throw Error("--kernel must be single, hybrid, shared or sorted, got '" + a.kernel + "'");
+  if (a.density == "pixel") o.density = DensityScheme::PerPixel;
+  else if (a.density == "cache") o.density = DensityScheme::SurfaceCache;
+  else throw Error("--density must be pixel or cache, got '" + a.density + "'");
+  if (!a.cacheCell.empty()) o.cacheCellFraction = parseFloat(a.cacheCell, "--cache-cell");
   o.stereo = parseStereoMode(a.stereo);
   if (a.eyes == "both") o.eyes[0] = o.eyes[1] = true;
   else if (a.eyes == "left") o.eyes[0] = true, o.eyes[1] = false;
@@ -699,7 +713,7 @@ int runCli(int argc, char** argv) {
   bench->add_option("--scenes", fa.scenes, "Scenes of the scenes suite (absent meshes are skipped)")->capture_default_str();
   bench->add_option("--scene-radius", fa.sceneRadius, "Search radius of the scenes suite, scene units")->capture_default_str();
   bench->add_option("--reference-passes", fa.referencePasses,
-                    "Passes of the scenes and quality suites' converged references (1024x1024 photons each)")
+                    "Passes of the tables, scenes and quality suites' converged references (1024x1024 photons each)")
       ->capture_default_str();
   bench->add_option("--quality-scenes", fa.qualityScenes, "Scenes of the quality suite (absent meshes are skipped)")
       ->capture_default_str();

@@ -44,6 +44,8 @@ const char* flagOf(RenderOption option) {
     case RenderOption::DenoiseIterations: return "--denoise-iterations";
     case RenderOption::PhotonBatches: return "--photon-batches";
     case RenderOption::DenoiseParameter: return "--denoise";
+    case RenderOption::Density: return "--density";
+    case RenderOption::CacheCell: return "--cache-cell";
   }
   return "--?";
 }

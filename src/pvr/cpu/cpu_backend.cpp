@@ -55,6 +55,65 @@ void CpuBackend::renderEye(const EyeCamera& camera, Eye eye, const GatherParams&
   renderEyeWith(camera, eye, params, map, out, reuse, surfaces, guides);
 }
 
+// shadePixel's sample loop split at the gather points, so that a sample's points of the whole
+// image enter the cache before any of them is finished.
+template <class Map>
+void CpuBackend::renderEyeCachedWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                                     HostSurfaceCache& cache, PixelSample* out, const StereoReuseView& reuse,
+                                     SurfaceRecord* surfaces, PixelGuide* guides) const {
+  SceneView view = scene_.view();
+  const size_t pixels = size_t(camera.width) * camera.height;
+  std::vector<GatherPoint> points(pixels);
+  std::vector<Vec3> radiance(pixels, Vec3(0.0f));
+  for (int s = 0; s < params.samplesPerPixel; ++s) {
+    parallelForTiles("eye rays", camera.height, camera.width, 16, [&](int y0, int y1, int x0, int x1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const size_t pixel = size_t(y) * camera.width + x;
+          if (s == 0) out[pixel] = PixelSample();
+          points[pixel] = pixelGatherPoint(view, intersector_, params, camera, eye, x, y, s, reuse, out[pixel],
+                                           s == 0 && surfaces ? surfaces + pixel : nullptr);
+          if (!guides) continue;
+          const GatherPoint& p = points[pixel];
+          PixelGuide& g = guides[pixel];
+          if (s == 0) g = PixelGuide(), g.albedo = p.demodulationAlbedo(), g.normal = p.normal;
+          g.direct += p.radiance;
+          g.emitted += p.emitted;
+        }
+    });
+    cache.insert(points.data(), pixels);
+    cache.estimateCreated(map, params.density);
+    const SurfaceCacheView cached = cache.view();
+    parallelFor("cached estimates", pixels, 4096, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) radiance[i] += finishGatherCached(cached, map, points[i], params.density);
+    });
+  }
+  const float inverseSamples = 1.0f / float(params.samplesPerPixel);
+  parallelFor("cached pixels", pixels, 4096, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      if (out[i].reusedFrom != kNotReused) {  // the other eye's finished colour, as shadePixel gives it
+        out[i].radiance = points[i].radiance;
+        if (guides) guides[i].direct = points[i].radiance, guides[i].emitted = Vec3(0.0f);
+        continue;
+      }
+      out[i].radiance = radiance[i] * inverseSamples;
+      if (guides) guides[i].direct *= inverseSamples, guides[i].emitted *= inverseSamples;
+    }
+  });
+}
+
+void CpuBackend::renderEyeCached(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
+                                 HostSurfaceCache& cache, PixelSample* out, const StereoReuseView& reuse,
+                                 SurfaceRecord* surfaces, PixelGuide* guides) const {
+  renderEyeCachedWith(camera, eye, params, map, cache, out, reuse, surfaces, guides);
+}
+
+void CpuBackend::renderEyeCached(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                                 HostSurfaceCache& cache, PixelSample* out, const StereoReuseView& reuse,
+                                 SurfaceRecord* surfaces, PixelGuide* guides) const {
+  renderEyeCachedWith(camera, eye, params, map, cache, out, reuse, surfaces, guides);
+}
+
 template <class Map>
 size_t CpuBackend::shadeMaskVerticesWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
                                          const FoveationMask& mask, int gazeX, int gazeY, std::vector<Vec3>& colours,

@@ -8,6 +8,7 @@
 #include "pvr/foveation/mask.h"
 #include "pvr/photon/gather.h"
 #include "pvr/photon/hash_grid.h"
+#include "pvr/photon/host_surface_cache.h"
 #include "pvr/photon/kd_tree.h"
 #include "pvr/photon/photon_trace.h"
 
@@ -30,6 +31,16 @@ class CpuBackend {
   void renderEye(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
                  PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
                  SurfaceRecord* surfaces = nullptr, PixelGuide* guides = nullptr) const;
+
+  // renderEye with the surface cache (DensityScheme::SurfaceCache): each sample's gather points
+  // go into `cache` as a pass of their own, its new cells are estimated, and the Lambertian points
+  // take their estimates from it (the cache keeps the cells of earlier passes and eyes).
+  void renderEyeCached(const EyeCamera& camera, Eye eye, const GatherParams& params, const HashGridView& map,
+                       HostSurfaceCache& cache, PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
+                       SurfaceRecord* surfaces = nullptr, PixelGuide* guides = nullptr) const;
+  void renderEyeCached(const EyeCamera& camera, Eye eye, const GatherParams& params, const KdTreeView& map,
+                       HostSurfaceCache& cache, PixelSample* out, const StereoReuseView& reuse = StereoReuseView(),
+                       SurfaceRecord* surfaces = nullptr, PixelGuide* guides = nullptr) const;
 
   // Foveated: shades the mask's vertices in use for the gaze pixel (gazeX, gazeY) into
   // `colours` and `inverseDepths` (one per mask vertex; unused ones untouched); returns the
@@ -58,6 +69,10 @@ class CpuBackend {
                                const FoveationMask& mask, int gazeX, int gazeY, std::vector<Vec3>& colours,
                                std::vector<float>& inverseDepths, const StereoReuseView& reuse,
                                SurfaceRecord* surfaces, size_t* reused) const;
+  template <class Map>
+  void renderEyeCachedWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
+                           HostSurfaceCache& cache, PixelSample* out, const StereoReuseView& reuse,
+                           SurfaceRecord* surfaces, PixelGuide* guides) const;
   template <class Map>
   void renderEyeWith(const EyeCamera& camera, Eye eye, const GatherParams& params, const Map& map,
                      PixelSample* out, const StereoReuseView& reuse, SurfaceRecord* surfaces,

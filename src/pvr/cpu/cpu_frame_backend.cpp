@@ -33,6 +33,8 @@ size_t CpuFrameBackend::tracePhotons(const PhotonTraceParams& params, int slot, 
 
 size_t CpuFrameBackend::buildPhotonMap(PhotonMapKind kind, float radius) {
   mapKind_ = kind;
+  if (!cacheStale_) lastCacheCells_ = cache_.cells();
+  cacheStale_ = true;
   if (kind == PhotonMapKind::HashGrid) {
     grid_ = HashGrid::build(photons_, radius);
     return grid_.memoryBytes();
@@ -80,7 +82,17 @@ void CpuFrameBackend::renderEyeWith(const EyePass& pass, const Map& map) {
   }
   samples_.assign(pixels, PixelSample());
   if (pass.denoiseGuides) guides_.assign(pixels, PixelGuide());
-  {
+  if (pass.density == DensityScheme::SurfaceCache) {
+    if (cacheStale_) {  // room for both eyes' points of every sample
+      cache_.reset(pass.cacheCellSize, surfaceCacheCapacity(2 * pixels * size_t(pass.gather.samplesPerPixel), lastCacheCells_));
+      cacheStale_ = false;
+    }
+    StageScope scope(clock_, Stage::EyeRays, e);  // eye rays, the cache and its look-ups in one stage
+    backend_.renderEyeCached(camera, pass.eye, pass.gather, map, cache_, samples_.data(), reuse, surfaces,
+                             pass.denoiseGuides ? guides_.data() : nullptr);
+    counters_.cacheCells = cache_.cells();
+    counters_.cacheUnplaced = cache_.unplacedPoints();
+  } else {
     StageScope scope(clock_, Stage::EyeRays, e);  // one fused pass, like the single kernel
     backend_.renderEye(camera, pass.eye, pass.gather, map, samples_.data(), reuse, surfaces,
                        pass.denoiseGuides ? guides_.data() : nullptr);

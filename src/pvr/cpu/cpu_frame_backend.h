@@ -50,6 +50,9 @@ class CpuFrameBackend : public FrameBackend {
   PhotonMapKind mapKind_ = PhotonMapKind::HashGrid;
   HashGrid grid_;
   KdTree tree_;
+  HostSurfaceCache cache_;
+  bool cacheStale_ = true;  ///< a new photon map: the cache starts again at its next use
+  size_t lastCacheCells_ = 0;
   std::vector<SurfaceRecord> sourceSurfaces_;
   std::vector<uint64_t> scattered_;
   std::vector<PixelSample> samples_;

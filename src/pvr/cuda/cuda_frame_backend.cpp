@@ -7,6 +7,7 @@
 #include "pvr/cuda/eye_pass.cuh"
 #include "pvr/cuda/photon_map_build.cuh"
 #include "pvr/cuda/photon_trace.cuh"
+#include "pvr/cuda/surface_cache.cuh"
 #include "pvr/cuda/temporal.cuh"
 #include "pvr/foveation/mask.h"
 
@@ -42,6 +43,7 @@ struct CudaFrameBackend::Impl {
   PhotonMapKind mapKind = PhotonMapKind::HashGrid;
   HashGridView gridView;
   KdTreeView treeView;
+  cuda::GpuSurfaceCache surfaceCache;  ///< over the map, for both eyes (DensityScheme::SurfaceCache)
   cuda::GpuEyePass eyePass;
   cuda::GpuDenoiser denoiser;
   cuda::GpuTemporal temporal;
@@ -49,7 +51,7 @@ struct CudaFrameBackend::Impl {
   cuda::EventTimer benchTimer;
   // What this frame did, for finishFrame() and readEye().
   struct FrameState {
-    bool rendered[2] = {false, false}, foveated[2] = {false, false}, temporal = false, reused = false;
+    bool rendered[2] = {false, false}, foveated[2] = {false, false}, temporal = false, reused = false, cached = false;
     size_t pixels[2] = {0, 0};
     int width[2] = {0, 0}, height[2] = {0, 0};
   } frame;
@@ -68,8 +70,9 @@ struct CudaFrameBackend::Impl {
   }
   ~Impl() { cudaStreamDestroy(stream); }
 
-  cuda::DeviceMap map() const {
+  cuda::DeviceMap map() {
     cuda::DeviceMap m;
+    m.surfaceCache = &surfaceCache;
     if (mapKind == PhotonMapKind::HashGrid) m.grid = &gridView;
     else m.tree = &treeView;
     return m;
@@ -136,6 +139,7 @@ size_t CudaFrameBackend::tracePhotons(const PhotonTraceParams& params, int slot,
 size_t CudaFrameBackend::buildPhotonMap(PhotonMapKind kind, float radius) {
   Impl& m = *impl_;
   m.mapKind = kind;
+  m.surfaceCache.invalidate();
   if (kind == PhotonMapKind::HashGrid) {
     m.grid.build(m.mapPhotons(), m.mapPhotonCount(), m.mapBounds(), radius, m.stream);
     m.gridView = m.grid.view();
@@ -158,6 +162,7 @@ void CudaFrameBackend::renderEye(const EyePass& pass) {
   m.frame.pixels[e] = size_t(pass.camera.width) * pass.camera.height;
   m.frame.width[e] = pass.camera.width, m.frame.height[e] = pass.camera.height;
   m.frame.reused = m.frame.reused || pass.role == StereoRole::Reuser;
+  m.frame.cached = m.frame.cached || (pass.density == DensityScheme::SurfaceCache && !pass.foveated());
   if (pass.foveated())
     m.eyePass.renderFoveated(m.deviceScene, m.map(), pass, m.uploadMask(*pass.mask), m.stream, *m.clock);
   else
@@ -218,8 +223,10 @@ FrameCounters CudaFrameBackend::finishFrame() {
   if (m.frame.foveated[0] || m.frame.foveated[1]) m.eyePass.downloadShadedVertices(shadedVertices, m.stream);
   if (m.frame.temporal) m.temporal.downloadHistoryPixels(historyPixels, m.stream);
   if (m.frame.reused) m.eyePass.downloadReusedCount(&reused, m.stream);
+  if (m.frame.cached) m.surfaceCache.downloadCounters(m.stream);
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));  // also surfaces the frame's faults, if any
   FrameCounters c;
+  if (m.frame.cached) c.cacheCells = m.surfaceCache.cells(), c.cacheUnplaced = m.surfaceCache.unplacedPoints();
   for (int e = 0; e < 2; ++e) {
     if (!m.frame.rendered[e]) continue;
     c.shadedSamples[e] = m.frame.foveated[e] ? shadedVertices[e] : m.frame.pixels[e];

@@ -4,6 +4,7 @@
 
 #include "pvr/cuda/density.cuh"
 #include "pvr/cuda/eye_kernels.cuh"
+#include "pvr/cuda/surface_cache.cuh"
 
 namespace pvr::cuda {
 namespace {
@@ -124,7 +125,8 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
   }
   StereoReuseView reuse = prepareReuse(pass, stream, out);
 
-  if (pass.kernel == DensityKernel::Single) {  // shadePixel loops over the samples itself
+  const bool cached = pass.density == DensityScheme::SurfaceCache;  // eye rays, then the cache: no kernel choice
+  if (pass.kernel == DensityKernel::Single && !cached) {  // shadePixel loops over the samples itself
     StageScope scope(clock, Stage::EyeRays, e);
     if (knn) dispatchSingle<Estimator::Knn>(scene, map, params, camera, eye, pass.role, reuse, out, stream);
     else dispatchSingle<Estimator::Radius>(scene, map, params, camera, eye, pass.role, reuse, out, stream);
@@ -132,8 +134,9 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
   }
 
   points_.reserve(pixels, "gather points");
-  const bool sparse = pass.role == StereoRole::Reuser && map.grid && !knn;  // few points left to estimate
-  const bool sorted = pass.kernel == DensityKernel::CellSorted && !sparse;
+  const bool sparse = !cached && pass.role == StereoRole::Reuser && map.grid && !knn;  // few points left to estimate
+  const bool sorted = !cached && pass.kernel == DensityKernel::CellSorted && !sparse;
+  if (cached) map.surfaceCache->prepare(pass.cacheCellSize, 2 * pixels * size_t(params.samplesPerPixel), stream);  // both eyes' points
   uint32_t noCell = 0;
   int endBit = 1;
   if (sorted) {
@@ -167,7 +170,9 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
              scene.intersector, params, camera, eye, s, reuse, points_.view(), out);
     }
     StageScope scope(clock, Stage::Density, e);
-    if (sparse) {
+    if (cached) {
+      map.surfaceCache->estimate(map, params.density, points_.view(), uint32_t(pixels), s, samples, image, stream);
+    } else if (sparse) {
       size_t bytes = temp_.capacity();
       PVR_CUDA_CHECK(cub::DeviceSelect::If(temp_.data(), bytes, thrust::counting_iterator<uint32_t>(0),
                                            estimateList_.data(), estimateCount_.data(), int(pixels),

@@ -9,10 +9,14 @@
 
 namespace pvr::cuda {
 
-// The photon map the eye pass reads: exactly one of the two is set.
+class GpuSurfaceCache;
+
+// The photon map the eye pass reads: exactly one of grid and tree is set; the surface cache over
+// it (DensityScheme::SurfaceCache, shared by both eyes' passes of the frame).
 struct DeviceMap {
   const HashGridView* grid = nullptr;
   const KdTreeView* tree = nullptr;
+  GpuSurfaceCache* surfaceCache = nullptr;
 };
 
 // Per-pixel outputs of an eye pass besides its image (null pointers are not written).

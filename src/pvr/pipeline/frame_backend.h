@@ -47,6 +47,8 @@ struct EyePass {
   GatherParams gather;
   PhotonMapKind map = PhotonMapKind::HashGrid;
   DensityKernel kernel = DensityKernel::Hybrid;
+  DensityScheme density = DensityScheme::PerPixel;
+  float cacheCellSize = 0.0f;  ///< the surface cache's cell side (scene units)
   StereoRole role = StereoRole::Alone;
   StereoMode reuse = StereoMode::Separate;  ///< the reuser's: scatter or gather
   EyeCamera source;                          ///< the reuser's: the eye it reuses (the left)
@@ -146,6 +148,8 @@ struct FrameCounters {
   size_t reusedSamples = 0;           ///< the reuser's samples that took the left eye's shading
   size_t historyPixels[2] = {0, 0};   ///< TAA: pixels that blended in their history
   size_t deviceBytes = 0;             ///< GPU memory held (0 on the CPU)
+  size_t cacheCells = 0;              ///< the surface cache's cells this frame (both eyes)
+  size_t cacheUnplaced = 0;           ///< points whose cell found no slot in the cache (estimated on their own)
 };
 
 class FrameBackend {

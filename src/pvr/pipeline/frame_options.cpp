@@ -16,6 +16,8 @@ const char* densityKernelName(DensityKernel k) {
   return "?";
 }
 
+const char* densitySchemeName(DensityScheme s) { return s == DensityScheme::SurfaceCache ? "cache" : "pixel"; }
+
 void validateRig(const StereoRig& rig) {
   if (rig.width < 1 || rig.height < 1 || rig.width > kMaxEyeDimension || rig.height > kMaxEyeDimension)
     throw OptionError(RenderOption::EyeSize, "the eye size must be between 1x1 and " + std::to_string(kMaxEyeDimension) +
@@ -53,6 +55,15 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
       o.map != PhotonMapKind::HashGrid)
     throw OptionError(RenderOption::Kernel,
                       std::string("the ") + densityKernelName(o.kernel) + " kernel works on the hash grid, not the kd-tree");
+  if (o.density == DensityScheme::SurfaceCache) {
+    if (!(o.cacheCellFraction >= kMinCacheCellFraction && o.cacheCellFraction <= kMaxCacheCellFraction))
+      throw OptionError(RenderOption::CacheCell, "the surface cache's cell must be between " +
+                                                     std::to_string(kMinCacheCellFraction).substr(0, 4) + " and " +
+                                                     std::to_string(kMaxCacheCellFraction).substr(0, 3) + " of the radius");
+    if (o.foveation.mask)
+      throw OptionError(RenderOption::Density, "the surface cache shades full-resolution eyes: a foveated pass "
+                                               "estimates at its mask's vertices (use --density pixel)");
+  }
   for (int e = 0; e < 2; ++e)
     for (float g : o.foveation.gaze[e])
       if (!(g >= 0.0f && g <= 1.0f))

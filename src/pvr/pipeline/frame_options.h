@@ -9,6 +9,7 @@
 #include "pvr/photon/gather.h"
 #include "pvr/photon/photon_map.h"
 #include "pvr/photon/photon_trace.h"
+#include "pvr/photon/surface_cache.h"
 #include "pvr/stereo/stereo_reuse.h"
 #include "pvr/temporal/taa.h"
 #include "pvr/util/error.h"
@@ -26,6 +27,13 @@ enum class DensityKernel : int {
 
 const char* densityKernelName(DensityKernel k);  ///< "single" | "hybrid" | "shared" | "sorted"
 
+// Where the photon-map estimates come from.
+enum class DensityScheme : int {
+  PerPixel = 0,      ///< the main paper's: an estimate at every gather point (by the kernel above)
+  SurfaceCache = 1,  ///< one per surface cell, shared by the pixels and eyes near it (photon/surface_cache.h)
+};
+const char* densitySchemeName(DensityScheme s);  ///< "pixel" | "cache"
+
 struct RenderOptions {
   uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
   int maxPhotonDepth = 8;
@@ -37,6 +45,8 @@ struct RenderOptions {
   int photonBatches = 1;
   PhotonMapKind map = PhotonMapKind::HashGrid;
   DensityKernel kernel = DensityKernel::Hybrid;
+  DensityScheme density = DensityScheme::PerPixel;
+  float cacheCellFraction = kDefaultCacheCellFraction;  ///< the surface cache's cell side over the radius
   GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
   bool eyes[2] = {true, true};
   StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading
@@ -65,7 +75,7 @@ constexpr int kMaxShadowRays = 64;
 // line names its flag).
 enum class RenderOption : int {
   Photons, PhotonDepth, Radius, K, SamplesPerPixel, SpecularDepth, ShadowRays, EyeSize, Ipd, Kernel, Gaze, TaaBlend,
-  TaaDepthTolerance, Stereo, DenoiseIterations, DenoiseParameter, PhotonBatches,
+  TaaDepthTolerance, Stereo, DenoiseIterations, DenoiseParameter, PhotonBatches, Density, CacheCell,
 };
 
 constexpr int kMaxPhotonBatches = 64;

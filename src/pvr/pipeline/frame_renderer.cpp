@@ -112,7 +112,8 @@ namespace {
 bool samePicture(const RenderOptions& a, const RenderOptions& b) {
   const GatherParams &ga = a.gather, &gb = b.gather;
   bool same = a.photonsX == b.photonsX && a.photonsY == b.photonsY && a.maxPhotonDepth == b.maxPhotonDepth &&
-              a.map == b.map && ga.density.radius == gb.density.radius && ga.density.estimator == gb.density.estimator &&
+              a.map == b.map && a.density == b.density && a.cacheCellFraction == b.cacheCellFraction &&
+              ga.density.radius == gb.density.radius && ga.density.estimator == gb.density.estimator &&
               ga.density.k == gb.density.k && ga.mode == gb.mode && ga.maxSpecularDepth == gb.maxSpecularDepth &&
               ga.samplesPerPixel == gb.samplesPerPixel && ga.punctualShadowRays == gb.punctualShadowRays &&
               ga.seed == gb.seed && a.eyes[0] == b.eyes[0] && a.eyes[1] == b.eyes[1] && a.stereo == b.stereo &&
@@ -234,6 +235,8 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
     pass.gather = options.gather;
     pass.map = options.map;
     pass.kernel = options.kernel;
+    pass.density = options.density;
+    pass.cacheCellSize = options.cacheCellFraction * options.gather.density.radius;
     // TAA keeps the emitted part out of its history; the denoiser also needs the rest.
     pass.denoiseGuides = options.denoise.enabled || options.temporal.enabled;
     pass.stillFrames = stillFrames_;
@@ -294,6 +297,8 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
                                                         : EyeImage::Rendered;
   }
   frame.reusedPixels = counters.reusedSamples;
+  frame.cacheCells = counters.cacheCells;
+  frame.cacheUnplaced = counters.cacheUnplaced;
   frame.deviceBytes = counters.deviceBytes;
   StageTimings& t = frame.timings;
   t.photonTraceMs = clock.ms(Stage::PhotonTrace, kWholeFrame);

@@ -49,6 +49,8 @@ struct FrameResult {
   size_t storedPhotons = 0;
   size_t mapBytes = 0;
   size_t deviceBytes = 0;  ///< GPU memory held by the backend (0 on the CPU)
+  size_t cacheCells = 0;     ///< DensityScheme::SurfaceCache: cells estimated this frame (both eyes)
+  size_t cacheUnplaced = 0;  ///< and points whose cell found no slot (estimated on their own)
   size_t reusedPixels = 0;  ///< right-eye pixels (mask vertices when foveated) that took the left eye's shading
   size_t shadedSamples[2] = {0, 0};  ///< per eye: pixels, or mask vertices when foveated
   size_t historyPixels[2] = {0, 0};  ///< TAA: per eye, pixels that blended in their history

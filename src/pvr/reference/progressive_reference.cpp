@@ -16,6 +16,7 @@ ProgressiveReference::ProgressiveReference(FrameRenderer& renderer, const Stereo
   if (!(settings.alpha > 0.0f && settings.alpha < 1.0f))
     throw Error("the reference's alpha must be between 0 and 1 (exclusive), got " + std::to_string(settings.alpha));
   options_.stereo = StereoMode::Separate;
+  options_.density = DensityScheme::PerPixel;  // an estimate per pixel: no cell's blur in the reference
   options_.foveation.mask = nullptr;
   options_.temporal.enabled = false;
   options_.denoise.enabled = false;
