@@ -3,7 +3,7 @@
 #   ../shared/gpu/bundle.sh .gpu build/photonvr build/tests/pvr_gpu_tests):
 # the CUDA-vs-CPU tests, every render mode and the GPU bad-input cases through the executable, and
 # compute-sanitizer (memcheck, racecheck, synccheck, initcheck) on representative render modes
-# (TAA with scatter reuse, foveated gather, denoised with a rolling photon map).
+# (TAA with scatter reuse, foveated gather, denoised with a rolling photon map, the surface cache).
 #   usage: scripts/gpu-suite.sh BUNDLE_DIR LOG_DIR [--no-sanitizer]
 # Prints one line per part and exits non-zero if any part failed; the logs go to LOG_DIR.
 set -u
@@ -41,6 +41,9 @@ if [ "${3:-}" != --no-sanitizer ] && command -v compute-sanitizer >/dev/null; th
       --trajectory tests/data/gaze_pursuit.traj
     part "sanitizer_${tool}_denoised" compute-sanitizer --tool "$tool" --error-exitcode 9 \
       "$bundle/photonvr" render cornell "${small[@]}" --denoise --photon-batches 4 --taa --stereo gather \
+      --trajectory tests/data/gaze_pursuit.traj
+    part "sanitizer_${tool}_cached" compute-sanitizer --tool "$tool" --error-exitcode 9 \
+      "$bundle/photonvr" render cornell-caustics "${small[@]}" --density cache --stereo gather --denoise \
       --trajectory tests/data/gaze_pursuit.traj
   done
 fi

@@ -51,13 +51,16 @@ __global__ void insertKernel(SurfaceCacheView cache, GatherPointStore points, ui
   if ((threadIdx.x & 31u) == unsigned(__ffs(group) - 1)) addToSurfaceCell(cache, key, total, DeviceAtomics());
 }
 
-// A warp per new cell, its lanes splitting each row's photons (the hash grid's radius estimate).
-__global__ void estimateCellsWarpKernel(SurfaceCacheView cache, HashGridView map, float radius) {
-  const unsigned lane = threadIdx.x & 31u;
-  const uint32_t warps = (gridDim.x * blockDim.x) >> 5;
+// A block per new cell, its threads splitting each row's photons (the hash grid's radius
+// estimate): a cell's candidates are the 27 map cells around it, tens of thousands of photons at
+// large radii, and there may be only a few thousand cells to spread over the GPU.
+constexpr int kCellBlock = 128;
+__global__ void __launch_bounds__(kCellBlock) estimateCellsBlockKernel(SurfaceCacheView cache, HashGridView map, float radius) {
+  __shared__ Vec3 warpSums[kCellBlock / 32];
+  const unsigned lane = threadIdx.x & 31u, warp = threadIdx.x >> 5;
   const float r2 = radius * radius;
   const uint32_t n = cache.counters[0];
-  for (uint32_t i = (blockIdx.x * blockDim.x + threadIdx.x) >> 5; i < n; i += warps) {  // warp-uniform
+  for (uint32_t i = blockIdx.x; i < n; i += gridDim.x) {  // block-uniform
     const uint32_t slot = cache.created[i];
     SurfaceCellEstimate e;
     Vec3 normal;
@@ -67,7 +70,7 @@ __global__ void estimateCellsWarpKernel(SurfaceCacheView cache, HashGridView map
     for (int row = 0; cell >= 0 && row < 9; ++row) {
       const uint32_t first = uint32_t(cell + map.rowOffsets[row]);
       const uint32_t end = map.cellStart[first + 3];
-      for (uint32_t j = map.cellStart[first] + lane; j < end; j += 32)
+      for (uint32_t j = map.cellStart[first] + threadIdx.x; j < end; j += kCellBlock)
         if (photonDistance2(e.point, map.position(j)) <= r2 && photonFacesSurface(map.photons[j].direction, normal))
           sum += map.photons[j].power;
     }
@@ -76,8 +79,15 @@ __global__ void estimateCellsWarpKernel(SurfaceCacheView cache, HashGridView map
       sum.y += __shfl_xor_sync(0xffffffffu, sum.y, offset);
       sum.z += __shfl_xor_sync(0xffffffffu, sum.z, offset);
     }
-    e.flux = sum * (1.0f / (kPi * r2));
-    if (lane == 0) cache.estimates[slot] = e;
+    if (lane == 0) warpSums[warp] = sum;
+    __syncthreads();
+    if (threadIdx.x == 0) {
+      Vec3 total = warpSums[0];
+      for (int w = 1; w < kCellBlock / 32; ++w) total += warpSums[w];
+      e.flux = total * (1.0f / (kPi * r2));
+      cache.estimates[slot] = e;
+    }
+    __syncthreads();  // warpSums is reused by the next cell
   }
 }
 
@@ -105,8 +115,9 @@ void estimateWith(const SurfaceCacheView& cache, const Map& map, const DensityPa
   const bool knn = density.estimator == Estimator::Knn;
   const unsigned blocks = unsigned(multiprocessorCount()) * 8u;  // grid-stride over the new cells
   if constexpr (std::is_same_v<Map, HashGridView>) {
-    if (!knn) launch("surface cache estimates (warp per cell)", estimateCellsWarpKernel, blocks, 256, 0, stream, cache, map,
-                     density.radius);
+    if (!knn)
+      launch("surface cache estimates (block per cell)", estimateCellsBlockKernel, unsigned(multiprocessorCount()) * 16u,
+             unsigned(kCellBlock), 0, stream, cache, map, density.radius);
     else launch("surface cache estimates", estimateCellsKernel<Map, Estimator::Knn>, blocks, 128, 0, stream, cache, map, density);
   } else {
     if (knn) launch("surface cache estimates", estimateCellsKernel<Map, Estimator::Knn>, blocks, 128, 0, stream, cache, map, density);

@@ -2,7 +2,7 @@
 // The surface cache on the GPU (photon/surface_cache.h): its table in device memory, sized by the
 // host's rule (surfaceCacheCapacity) from the cells of the frame before, so the CPU and the GPU
 // make the same cells. Insertion sums a warp's points of one cell before one lane adds them (a
-// cell spans many neighbouring pixels); each new cell is estimated by a warp (hash grid, radius
+// cell spans many neighbouring pixels); each new cell is estimated by a block (hash grid, radius
 // estimate) or a thread (kNN, kd-tree); then every pixel looks its estimate up.
 #include "pvr/cuda/eye_pass.cuh"
 #include "pvr/photon/surface_cache.h"
