@@ -79,7 +79,8 @@ PVR_HOST_DEVICE inline SurfaceCellSums surfacePointSums(Vec3 p, Vec3 n, const in
     float u = p[a] * invCellSize - float(cell[a]);
     u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
     s.position[a] = (unsigned long long)(u * scale);
-    s.normal[a] = (unsigned long long)(long long)(n[a] * scale);
+    const float c = fmaxf(-1.0f, fminf(n[a], 1.0f));  // also maps a NaN component into range
+    s.normal[a] = (unsigned long long)(long long)(c * scale);
   }
   s.count = 1;
   return s;
