@@ -50,6 +50,17 @@ std::vector<Photon> floorPhotons(size_t n, std::mt19937& rng) {
   return photons;
 }
 
+// 5,000 floor photons in a hash grid of radius 0.1, and the radius estimate over it.
+struct FloorMap {
+  HashGrid grid;
+  DensityParams density;
+};
+FloorMap floorMap(std::mt19937& rng) {
+  FloorMap m{HashGrid::build(floorPhotons(5000, rng), 0.1f), DensityParams()};
+  m.density.radius = 0.1f;
+  return m;
+}
+
 // Every cell of the table: key to estimate.
 std::map<uint64_t, SurfaceCellEstimate> cellsOf(HostSurfaceCache& cache) {
   std::map<uint64_t, SurfaceCellEstimate> cells;
@@ -192,11 +203,8 @@ TEST(SurfaceCache, TheWallsOfACornerDoNotShareCells) {
 
 TEST(SurfaceCache, InsertionOrderAndThreadsDoNotChangeACell) {
   std::mt19937 rng(11);
-  const std::vector<Photon> photons = floorPhotons(5000, rng);
-  const HashGrid grid = HashGrid::build(photons, 0.1f);
+  const auto [grid, density] = floorMap(rng);
   std::vector<GatherPoint> points = floorPoints(-0.6f, 0.6f, -0.6f, 0.6f, 150, rng);
-  DensityParams density;
-  density.radius = 0.1f;
   auto build = [&](const std::vector<GatherPoint>& in) {
     HostSurfaceCache cache;
     cache.reset(0.02f, surfaceCacheCapacity(in.size(), 0));
@@ -221,9 +229,7 @@ TEST(SurfaceCache, InsertionOrderAndThreadsDoNotChangeACell) {
 // A second pass (the other eye, or the next sample) keeps the cells it finds and adds the rest.
 TEST(SurfaceCache, ALaterPassKeepsEarlierCellsAndAddsNewOnes) {
   std::mt19937 rng(13);
-  const HashGrid grid = HashGrid::build(floorPhotons(5000, rng), 0.1f);
-  DensityParams density;
-  density.radius = 0.1f;
+  const auto [grid, density] = floorMap(rng);
   const std::vector<GatherPoint> left = floorPoints(-0.5f, 0.2f, -0.5f, 0.5f, 100, rng);
   const std::vector<GatherPoint> right = floorPoints(-0.2f, 0.5f, -0.5f, 0.5f, 100, rng);
   HostSurfaceCache cache;
@@ -253,9 +259,7 @@ TEST(SurfaceCache, ALaterPassKeepsEarlierCellsAndAddsNewOnes) {
 // own (finishGatherCached falls back), never lost.
 TEST(SurfaceCache, AFullTableFallsBackToThePointsOwnEstimate) {
   std::mt19937 rng(17);
-  const HashGrid grid = HashGrid::build(floorPhotons(5000, rng), 0.1f);
-  DensityParams density;
-  density.radius = 0.1f;
+  const auto [grid, density] = floorMap(rng);
   const std::vector<GatherPoint> points = floorPoints(-0.5f, 0.5f, -0.5f, 0.5f, 200, rng);
   HostSurfaceCache cache;
   cache.reset(0.01f, 1024);  // 10,000 cells of points
@@ -280,9 +284,7 @@ TEST(SurfaceCache, AFullTableFallsBackToThePointsOwnEstimate) {
 // Microfacet points (view-dependent) and points that need no estimate bypass the cache exactly.
 TEST(SurfaceCache, GlossyPointsAreEstimatedPerPixel) {
   std::mt19937 rng(19);
-  const HashGrid grid = HashGrid::build(floorPhotons(5000, rng), 0.1f);
-  DensityParams density;
-  density.radius = 0.1f;
+  const auto [grid, density] = floorMap(rng);
   std::vector<GatherPoint> points = floorPoints(-0.5f, 0.5f, -0.5f, 0.5f, 50, rng);
   HostSurfaceCache cache;
   cache.reset(0.025f, surfaceCacheCapacity(points.size(), 0));
