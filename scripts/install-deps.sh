@@ -8,7 +8,7 @@ packages=(
   libembree-dev libtbb-dev libassimp-dev libcgal-dev
   libcli11-dev nlohmann-json3-dev libstb-dev libopenexr-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libvulkan-dev mesa-vulkan-drivers libopenxr-dev libglfw3-dev libimgui-dev
+  libvulkan-dev glslc mesa-vulkan-drivers libopenxr-dev libglfw3-dev libimgui-dev
   xvfb xauth assimp-testmodels
   "$@"
 )

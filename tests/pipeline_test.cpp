@@ -26,11 +26,12 @@ class RecordingBackend : public FrameBackend {
   StageClock& clock() override { return clock_; }
   size_t tracePhotons(const PhotonTraceParams&, int, int) override { return record("trace"), 0; }
   size_t buildPhotonMap(PhotonMapKind, float) override { return record("build"), 0; }
+  void rasterizePrimary(const EyeCamera*) override { record("raster"); }
   void scatter(const EyeCamera&, const EyeCamera&) override { record("scatter"); }
   void renderEye(const EyePass& pass) override {
     static const char* roles[] = {"alone", "source", "reuser"};
     record(std::string("eye ") + (pass.eye == Eye::Left ? "left " : "right ") + roles[int(pass.role)] +
-           (pass.foveated() ? " foveated" : ""));
+           (pass.foveated() ? " foveated" : "") + (pass.rasterPrimary ? " from raster" : ""));
   }
   float inverseDepthAt(Eye eye, size_t) override { return record(eye == Eye::Left ? "depth left" : "depth right"), 0.0f; }
   void denoise(const EyePass& pass, const DenoiseParams&) override {
@@ -67,6 +68,18 @@ StereoRig tinyRig() {
   StereoRig rig;
   rig.width = 32, rig.height = 36;
   return rig;
+}
+
+TEST(FramePipeline, TheRasterPrePassRunsOnceBeforeBothEyesThatReadIt) {
+  auto backend = std::make_unique<RecordingBackend>();
+  RecordingBackend& r = *backend;
+  FrameRenderer renderer(std::move(backend));
+  RenderOptions o;
+  o.primary = PrimaryVisibility::Raster;
+  o.stereo = StereoMode::Gather;
+  renderer.render(tinyRig(), o);
+  EXPECT_EQ(joined(r.calls), "trace, build, raster, eye left source from raster, forget left, "
+                             "eye right reuser from raster, forget right, finish, read left, read right");
 }
 
 TEST(FramePipeline, RunsTheStagesInOneOrder) {

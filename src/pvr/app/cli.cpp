@@ -74,6 +74,7 @@ struct RenderArgs {
   std::string kernel = "hybrid";
   std::string density = "pixel";
   std::string cacheCell;  // empty: kDefaultCacheCellFraction
+  std::string primary = "rays";
   std::string backend = "auto";
   std::string stereo = "separate";
   int k = 32;
@@ -131,6 +132,7 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     text("kernel", "--kernel", a.kernel);
     text("density", "--density", a.density);
     text("cache_cell", "--cache-cell", a.cacheCell);
+    text("primary", "--primary", a.primary);
     text("backend", "--backend", a.backend);
     text("stereo", "--stereo", a.stereo);
     text("eye_size", "--eye-size", a.eyeSize);
@@ -187,6 +189,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
       ->capture_default_str();
   cmd.add_option("--cache-cell", a.cacheCell, "The surface cache's cell side as a fraction of the radius (0.01..1, "
                                               "default 0.25)");
+  cmd.add_option("--primary", a.primary,
+                 "First hits of the eye rays: rays (traced) | raster (Ray-VR's G-buffer pre-pass: both eyes rasterised "
+                 "by Vulkan in one multiview pass, on the CUDA GPU or, for the CPU backend, any Vulkan device)")
+      ->capture_default_str();
   cmd.add_option("--backend", a.backend, "cpu (Embree + TBB reference) | cuda | auto (cuda if a GPU is present)")
       ->capture_default_str();
   cmd.add_option("--stereo", a.stereo,
@@ -261,6 +267,9 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   else if (a.density == "cache") o.density = DensityScheme::SurfaceCache;
   else throw Error("--density must be pixel or cache, got '" + a.density + "'");
   if (!a.cacheCell.empty()) o.cacheCellFraction = parseFloat(a.cacheCell, "--cache-cell");
+  if (a.primary == "rays") o.primary = PrimaryVisibility::Rays;
+  else if (a.primary == "raster") o.primary = PrimaryVisibility::Raster;
+  else throw Error("--primary must be rays or raster, got '" + a.primary + "'");
   o.stereo = parseStereoMode(a.stereo);
   if (a.eyes == "both") o.eyes[0] = o.eyes[1] = true;
   else if (a.eyes == "left") o.eyes[0] = true, o.eyes[1] = false;
@@ -394,6 +403,8 @@ int runRender(const RenderArgs& a) {
   FrameResult frame = renderer->render(rig, options);
   std::printf("  photon trace  %9.2f ms  (%zu photons stored)\n", frame.timings.photonTraceMs, frame.storedPhotons);
   std::printf("  map build     %9.2f ms  (%.1f MiB)\n", frame.timings.mapBuildMs, frame.mapBytes / 1048576.0);
+  if (options.primary == PrimaryVisibility::Raster)
+    std::printf("  raster pass   %9.2f ms  (both eyes' first hits, Vulkan multiview)\n", frame.timings.primaryMs);
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;
     std::printf("  %-5s eye     %9.2f ms  (eye rays %.2f, density %.2f", names[e], frame.timings.eyeMs[e],

@@ -65,6 +65,8 @@ nlohmann::json describeRun(const Renderer& renderer, const LoopSetup& setup, con
           {"radius", o.gather.density.radius},
           {"stereo", stereoModeName(o.stereo)},
           {"kernel", densityKernelName(o.kernel)},
+          {"density", densitySchemeName(o.density)},
+          {"primary", primaryVisibilityName(o.primary)},
           {"foveated", o.foveation.mask != nullptr},
           {"taa", o.temporal.enabled},
           {"denoise", o.denoise.enabled}};

@@ -5,7 +5,27 @@
 #include <fstream>
 #include <string>
 
+#include "pvr/raster/gbuffer_raster.h"
+
 namespace pvr {
+
+CpuFrameBackend::CpuFrameBackend(const Scene& scene) : backend_(scene) {}
+CpuFrameBackend::~CpuFrameBackend() = default;  // the pre-pass before its Vulkan device
+
+void CpuFrameBackend::rasterizePrimary(const EyeCamera eyes[2]) {
+  StageScope scope(clock_, Stage::Primary);  // the host waits for it: its time is the frame's
+  if (!raster_) {
+    try {
+      rasterVulkan_ = std::make_unique<VulkanContext>(VulkanContextOptions());
+    } catch (const Error& e) {
+      throw Error(std::string("--primary raster: ") + e.what());
+    }
+    raster_ = std::make_unique<GBufferRaster>(*rasterVulkan_, backend_.scene(), false);
+  }
+  raster_->render(eyes);
+  raster_->waitDone();
+  rasterised_ = true;
+}
 
 std::string CpuFrameBackend::deviceName() const {
   std::ifstream cpuinfo("/proc/cpuinfo");
@@ -123,8 +143,13 @@ void CpuFrameBackend::renderEyeWith(const EyePass& pass, const Map& map) {
 }
 
 void CpuFrameBackend::renderEye(const EyePass& pass) {
-  if (mapKind_ == PhotonMapKind::HashGrid) renderEyeWith(pass, grid_.view());
-  else renderEyeWith(pass, tree_.view());
+  EyePass p = pass;
+  if (pass.rasterPrimary) {
+    if (!rasterised_) throw Error("frame pipeline: an eye pass reads rasterised first hits this frame did not make");
+    p.gather.primary = raster_->hostView(pass.eye);
+  }
+  if (mapKind_ == PhotonMapKind::HashGrid) renderEyeWith(p, grid_.view());
+  else renderEyeWith(p, tree_.view());
 }
 
 void CpuFrameBackend::denoise(const EyePass& pass, const DenoiseParams& params) {
@@ -163,6 +188,7 @@ void CpuFrameBackend::resolveTemporal(const TemporalPass& pass) {
 FrameCounters CpuFrameBackend::finishFrame() {
   FrameCounters done = counters_;  // the CPU's stages finished as they returned
   counters_ = FrameCounters();
+  rasterised_ = false;
   return done;
 }
 

@@ -11,15 +11,21 @@
 
 namespace pvr {
 
+class VulkanContext;
+class GBufferRaster;
+
 class CpuFrameBackend : public FrameBackend {
  public:
-  explicit CpuFrameBackend(const Scene& scene) : backend_(scene) {}
+  explicit CpuFrameBackend(const Scene& scene);
+  ~CpuFrameBackend() override;
   std::string name() const override { return "cpu"; }
   std::string deviceName() const override;
   StageClock& clock() override { return clock_; }
 
   size_t tracePhotons(const PhotonTraceParams& params, int slot, int slots) override;
   size_t buildPhotonMap(PhotonMapKind kind, float radius) override;
+  // The G-buffer pre-pass on the Vulkan device it finds (a GPU, or lavapipe), read from host memory.
+  void rasterizePrimary(const EyeCamera eyes[2]) override;
   void scatter(const EyeCamera& source, const EyeCamera& target) override;
   void renderEye(const EyePass& pass) override;
   float inverseDepthAt(Eye eye, size_t pixel) override { return eyes_[int(eye)].inverseDepth.at(pixel); }
@@ -61,6 +67,9 @@ class CpuFrameBackend : public FrameBackend {
   TaaHistory history_[2];
   HostDenoiser denoiser_;
   FrameCounters counters_;
+  std::unique_ptr<VulkanContext> rasterVulkan_;  ///< made at the first pre-pass
+  std::unique_ptr<GBufferRaster> raster_;
+  bool rasterised_ = false;  ///< this frame's pre-pass ran
 };
 
 // A frame renderer on the CPU reference backend.

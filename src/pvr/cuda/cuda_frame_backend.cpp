@@ -1,15 +1,18 @@
 #include "pvr/cuda/cuda_frame_backend.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "pvr/cuda/cuda_stage_clock.h"
 #include "pvr/cuda/denoise.cuh"
+#include "pvr/cuda/display_handover.h"
 #include "pvr/cuda/eye_pass.cuh"
 #include "pvr/cuda/photon_map_build.cuh"
 #include "pvr/cuda/photon_trace.cuh"
 #include "pvr/cuda/surface_cache.cuh"
 #include "pvr/cuda/temporal.cuh"
 #include "pvr/foveation/mask.h"
+#include "pvr/raster/gbuffer_raster.h"
 
 namespace pvr {
 
@@ -48,10 +51,20 @@ struct CudaFrameBackend::Impl {
   cuda::GpuDenoiser denoiser;
   cuda::GpuTemporal temporal;
   std::unique_ptr<cuda::CudaStageClock> clock;
+  // The G-buffer pre-pass: Vulkan on this GPU, its buffer and semaphores imported (made at first use).
+  struct Raster {
+    std::unique_ptr<VulkanContext> vulkan;
+    std::unique_ptr<GBufferRaster> pass;
+    std::unique_ptr<cuda::SharedBuffer> buffer;
+    uint64_t generation = 0;
+    std::unique_ptr<cuda::SharedSemaphore> done, readersDone;
+    bool readersSignalled = false;  ///< CUDA signalled readersDone after the last frame's reads
+  } raster;
   cuda::EventTimer benchTimer;
   // What this frame did, for finishFrame() and readEye().
   struct FrameState {
-    bool rendered[2] = {false, false}, foveated[2] = {false, false}, temporal = false, reused = false, cached = false;
+    bool rendered[2] = {false, false}, foveated[2] = {false, false}, temporal = false, reused = false, cached = false,
+         rasterised = false;
     size_t pixels[2] = {0, 0};
     int width[2] = {0, 0}, height[2] = {0, 0};
   } frame;
@@ -68,7 +81,25 @@ struct CudaFrameBackend::Impl {
     clock = std::make_unique<cuda::CudaStageClock>(stream);
     deviceScene.upload(scene, bvh);
   }
-  ~Impl() { cudaStreamDestroy(stream); }
+  ~Impl() {
+    cudaStreamSynchronize(stream);  // nothing reads the imported G-buffer any more
+    raster.buffer.reset();
+    raster.done.reset();
+    raster.readersDone.reset();
+    raster.pass.reset();
+    raster.vulkan.reset();
+    cudaStreamDestroy(stream);
+  }
+
+  PrimaryHitsView primaryHits(Eye eye) const {
+    PrimaryHitsView v;
+    const size_t pixels = size_t(raster.pass->width()) * size_t(raster.pass->height());
+    auto* bytes = static_cast<const unsigned char*>(raster.buffer->data());
+    v.prim = reinterpret_cast<const uint32_t*>(bytes) + pixels * size_t(eye);
+    v.barycentrics = reinterpret_cast<const Vec2*>(bytes + 2 * pixels * sizeof(uint32_t)) + pixels * size_t(eye);
+    v.width = raster.pass->width();
+    return v;
+  }
 
   cuda::DeviceMap map() {
     cuda::DeviceMap m;
@@ -150,6 +181,34 @@ size_t CudaFrameBackend::buildPhotonMap(PhotonMapKind kind, float radius) {
   return m.tree.memoryBytes();
 }
 
+void CudaFrameBackend::rasterizePrimary(const EyeCamera eyes[2]) {
+  Impl& m = *impl_;
+  Impl::Raster& r = m.raster;
+  if (!r.pass) {
+    VulkanContextOptions options;
+    options.hasPreferredUuid = cuda::currentDeviceUuid(options.preferredUuid);
+    try {
+      r.vulkan = std::make_unique<VulkanContext>(options);
+    } catch (const Error& e) {
+      throw Error(std::string("--primary raster: ") + e.what());
+    }
+    if (!options.hasPreferredUuid || std::memcmp(r.vulkan->deviceUuid(), options.preferredUuid, 16) != 0)
+      throw Error("--primary raster: Vulkan found no device that is the CUDA GPU (it found '" + r.vulkan->deviceName() + "')");
+    r.pass = std::make_unique<GBufferRaster>(*r.vulkan, m.scene, true);
+    r.done = std::make_unique<cuda::SharedSemaphore>(r.pass->exportRasterDoneFd());
+    r.readersDone = std::make_unique<cuda::SharedSemaphore>(r.pass->exportReadersDoneFd());
+  }
+  r.pass->render(eyes, r.readersSignalled);
+  r.readersSignalled = false;
+  if (r.pass->bufferGeneration() != r.generation) {  // a new buffer (first use, new eye size): import it
+    r.buffer.reset();
+    r.buffer = std::make_unique<cuda::SharedBuffer>(r.pass->exportBufferFd(), r.pass->bufferAllocationBytes(), r.pass->bufferBytes());
+    r.generation = r.pass->bufferGeneration();
+  }
+  r.done->wait(m.stream);
+  m.frame.rasterised = true;
+}
+
 void CudaFrameBackend::scatter(const EyeCamera& /*source: the records hold world positions*/, const EyeCamera& target) {
   impl_->eyePass.scatter(impl_->deviceScene, target, impl_->stream);
 }
@@ -163,10 +222,15 @@ void CudaFrameBackend::renderEye(const EyePass& pass) {
   m.frame.width[e] = pass.camera.width, m.frame.height[e] = pass.camera.height;
   m.frame.reused = m.frame.reused || pass.role == StereoRole::Reuser;
   m.frame.cached = m.frame.cached || (pass.density == DensityScheme::SurfaceCache && !pass.foveated());
-  if (pass.foveated())
-    m.eyePass.renderFoveated(m.deviceScene, m.map(), pass, m.uploadMask(*pass.mask), m.stream, *m.clock);
+  EyePass p = pass;
+  if (pass.rasterPrimary) {
+    if (!m.frame.rasterised) throw Error("frame pipeline: an eye pass reads rasterised first hits this frame did not make");
+    p.gather.primary = m.primaryHits(pass.eye);
+  }
+  if (p.foveated())
+    m.eyePass.renderFoveated(m.deviceScene, m.map(), p, m.uploadMask(*p.mask), m.stream, *m.clock);
   else
-    m.eyePass.render(m.deviceScene, m.map(), pass, m.stream, *m.clock);
+    m.eyePass.render(m.deviceScene, m.map(), p, m.stream, *m.clock);
 }
 
 float CudaFrameBackend::inverseDepthAt(Eye eye, size_t pixel) {
@@ -224,7 +288,12 @@ FrameCounters CudaFrameBackend::finishFrame() {
   if (m.frame.temporal) m.temporal.downloadHistoryPixels(historyPixels, m.stream);
   if (m.frame.reused) m.eyePass.downloadReusedCount(&reused, m.stream);
   if (m.frame.cached) m.surfaceCache.downloadCounters(m.stream);
+  if (m.frame.rasterised) {  // the next pre-pass may overwrite the G-buffer once the reads are done
+    m.raster.readersDone->signal(m.stream);
+    m.raster.readersSignalled = true;
+  }
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));  // also surfaces the frame's faults, if any
+  if (m.frame.rasterised) m.clock->add(Stage::Primary, kWholeFrame, m.raster.pass->lastGpuMs());
   FrameCounters c;
   if (m.frame.cached) c.cacheCells = m.surfaceCache.cells(), c.cacheUnplaced = m.surfaceCache.unplacedPoints();
   for (int e = 0; e < 2; ++e) {

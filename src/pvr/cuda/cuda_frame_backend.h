@@ -38,6 +38,7 @@ class CudaFrameBackend : public FrameBackend {
 
   size_t tracePhotons(const PhotonTraceParams& params, int slot, int slots) override;
   size_t buildPhotonMap(PhotonMapKind kind, float radius) override;
+  void rasterizePrimary(const EyeCamera eyes[2]) override;
   void scatter(const EyeCamera& source, const EyeCamera& target) override;
   void renderEye(const EyePass& pass) override;
   float inverseDepthAt(Eye eye, size_t pixel) override;

@@ -3,7 +3,7 @@
 namespace pvr::cuda {
 
 void CudaStageClock::newFrame() {
-  for (Slot& s : slots_) s.used = 0;
+  for (Slot& s : slots_) s.used = 0, s.added = 0;
 }
 
 void CudaStageClock::begin(Stage stage, int eye) {
@@ -21,7 +21,7 @@ void CudaStageClock::end(Stage stage, int eye) {
 
 double CudaStageClock::ms(Stage stage, int eye) {
   const Slot& s = slots_[slot(stage, eye)];
-  double total = 0;
+  double total = s.added;
   for (int r = 0; r < s.used; ++r) total += s.runs[r]->ms();
   return total;
 }

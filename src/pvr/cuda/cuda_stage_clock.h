@@ -20,11 +20,13 @@ class CudaStageClock : public StageClock {
   void begin(Stage stage, int eye) override;
   void end(Stage stage, int eye) override;
   double ms(Stage stage, int eye) override;  ///< waits for the stage's last event
+  void add(Stage stage, int eye, double ms) override { slots_[slot(stage, eye)].added += ms; }
 
  private:
   struct Slot {
     std::vector<std::unique_ptr<EventTimer>> runs;  ///< grow-only, reused across frames
     int used = 0;
+    double added = 0;  ///< times measured elsewhere (Vulkan timestamps)
   };
   static int slot(Stage stage, int eye) { return int(stage) * 3 + eye + 1; }
   cudaStream_t stream_;

@@ -149,6 +149,12 @@ void SharedSemaphore::signal(void* stream) {
   PVR_CUDA_CHECK(cudaSignalExternalSemaphoresAsync(&semaphore, &params, 1, static_cast<cudaStream_t>(stream)));
 }
 
+void SharedSemaphore::wait(void* stream) {
+  cudaExternalSemaphoreWaitParams params{};
+  cudaExternalSemaphore_t semaphore = static_cast<cudaExternalSemaphore_t>(semaphore_);
+  PVR_CUDA_CHECK(cudaWaitExternalSemaphoresAsync(&semaphore, &params, 1, static_cast<cudaStream_t>(stream)));
+}
+
 HandOverEvents::HandOverEvents() {
   cudaEvent_t a, b;
   PVR_CUDA_CHECK(cudaEventCreate(&a));

@@ -44,7 +44,8 @@ class SharedSurface {
   unsigned long long surface_ = 0;
 };
 
-// A Vulkan (binary) semaphore that CUDA signals when its work on a stream is done.
+// A Vulkan (binary) semaphore that CUDA signals when its work on a stream is done, or that CUDA's
+// later work on a stream waits for (Vulkan signals it).
 class SharedSemaphore {
  public:
   explicit SharedSemaphore(int fd);
@@ -52,6 +53,7 @@ class SharedSemaphore {
   SharedSemaphore(const SharedSemaphore&) = delete;
   SharedSemaphore& operator=(const SharedSemaphore&) = delete;
   void signal(void* stream);  // cudaStream_t
+  void wait(void* stream);    // cudaStream_t
 
  private:
   void* semaphore_ = nullptr;  // cudaExternalSemaphore_t

@@ -53,6 +53,9 @@ nlohmann::json FrameStats::toJson() const {
           {"stages_ms",
            {{"photon_trace", stage([](const StageTimings& t) { return t.photonTraceMs; })},
             {"map_build", stage([](const StageTimings& t) { return t.mapBuildMs; })},
+            {"raster_prepass", stage([](const StageTimings& t) { return t.primaryMs; })},
+            {"left_eye_rays", stage([](const StageTimings& t) { return t.eyeRayMs[0]; })},
+            {"right_eye_rays", stage([](const StageTimings& t) { return t.eyeRayMs[1]; })},
             {"left_eye", stage([](const StageTimings& t) { return t.eyeMs[0]; })},
             {"right_eye", stage([](const StageTimings& t) { return t.eyeMs[1]; })}}}};
 }

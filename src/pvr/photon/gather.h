@@ -10,6 +10,7 @@
 //    formulation; the map then holds every photon including the direct ones).
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/photon/density.h"
+#include "pvr/raster/primary_hits.h"
 #include "pvr/shading/scene_view.h"
 #include "pvr/stereo/stereo_reuse.h"
 #include "pvr/util/rng.h"
@@ -29,6 +30,9 @@ struct GatherParams {
   int punctualShadowRays = 1;
   bool jitterFirstSample = false;  ///< false: sample 0 through the pixel centre (a stable first hit)
   uint32_t seed = 1;
+  // Sample 0's first hits rasterised (the G-buffer pre-pass), set by the backend for one eye pass;
+  // none: traced. Ignored when the first sample is jittered.
+  PrimaryHitsView primary;
 };
 
 // One pixel's result. Sample 0 (the centre ray) decides everything but the radiance.
@@ -374,7 +378,9 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
   if (s > 0) return traceToGatherPoint(scene, intersector, params, ray, rng, nullptr, camera.pixelSpread());
   Hit first;
-  intersector.intersect(ray, INFINITY, first);
+  if (!params.primary.present() || params.jitterFirstSample ||
+      !rasterisedFirstHit(scene, params.primary, x, y, ray, first))
+    intersector.intersect(ray, INFINITY, first);
   pixel.firstPrim = first.primId;
   pixel.inverseDepth = firstHitInverseDepth(camera, ray, first);
   if (surfaceOut) *surfaceOut = surfaceRecordOf(scene, camera, ray, first);

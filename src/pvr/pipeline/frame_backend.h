@@ -5,11 +5,12 @@
 //
 //   stage          reads                                        writes
 //   photon trace   scene                                        Photons
+//   primary        scene (rasterised, both eyes)                PrimaryHits
 //   map build      Photons                                      PhotonMap
 //   scatter        SourceSurfaces                               ScatteredSurfaces
-//   eye pass       PhotonMap; reuser: SourceSurfaces, the       RenderedImage, InverseDepth;
-//                  left RenderedImage, (scatter)                full: FirstHits; foveated:
-//                  ScatteredSurfaces                            SampleSpacing; source:
+//   eye pass       PhotonMap; raster: PrimaryHits; reuser:     RenderedImage, InverseDepth;
+//                  SourceSurfaces, the left RenderedImage,      full: FirstHits; foveated:
+//                  (scatter) ScatteredSurfaces                  SampleSpacing; source:
 //                                                               SourceSurfaces; full reuser:
 //                                                               ReusedFrom; full, denoising:
 //                                                               DenoiseGuides
@@ -50,6 +51,7 @@ struct EyePass {
   DensityScheme density = DensityScheme::PerPixel;
   float cacheCellSize = 0.0f;  ///< the surface cache's cell side (scene units)
   StereoRole role = StereoRole::Alone;
+  bool rasterPrimary = false;  ///< sample 0's first hits from the frame's G-buffer pre-pass (rasterizePrimary)
   StereoMode reuse = StereoMode::Separate;  ///< the reuser's: scatter or gather
   EyeCamera source;                          ///< the reuser's: the eye it reuses (the left)
   const FoveationMask* mask = nullptr;       ///< foveated: the mask, placed at the gaze pixel
@@ -89,6 +91,7 @@ inline StereoReuseView reuseViewFor(const EyePass& pass, const SurfaceRecord* so
 enum class FrameData : int {
   Photons = 0,
   PhotonMap,
+  PrimaryHits,        ///< per pixel of each eye, the rasterised first hit (the G-buffer pre-pass)
   SourceSurfaces,     ///< per left pixel: the surface the right eye may reuse
   ScatteredSurfaces,  ///< per right pixel: the nearest left surface projected there
   RenderedImage,      ///< the eye's image as shaded (what the reuser reads of the left eye)
@@ -114,6 +117,7 @@ struct StageIO {
 };
 
 StageIO photonTraceIO();
+StageIO primaryIO(const bool eyes[2]);
 StageIO mapBuildIO();
 StageIO scatterIO();
 StageIO eyePassIO(const EyePass& pass);
@@ -166,6 +170,9 @@ class FrameBackend {
   virtual size_t tracePhotons(const PhotonTraceParams& params, int slot, int slots) = 0;
   // Map build over the stored photons: returns the map's bytes.
   virtual size_t buildPhotonMap(PhotonMapKind kind, float radius) = 0;
+  // The G-buffer pre-pass: both eyes' first hits rasterised at their pixel centres (the eyes of
+  // one rig: same size), for the eye passes with rasterPrimary. Times itself (Stage::Primary).
+  virtual void rasterizePrimary(const EyeCamera eyes[2]) = 0;
   // Scatter: the source eye's surfaces into the target eye's image.
   virtual void scatter(const EyeCamera& source, const EyeCamera& target) = 0;
   // The eye pass; times its own parts (EyeRays, Density, Reconstruct) on clock() for pass.eye.

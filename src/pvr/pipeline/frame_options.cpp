@@ -17,6 +17,7 @@ const char* densityKernelName(DensityKernel k) {
 }
 
 const char* densitySchemeName(DensityScheme s) { return s == DensityScheme::SurfaceCache ? "cache" : "pixel"; }
+const char* primaryVisibilityName(PrimaryVisibility p) { return p == PrimaryVisibility::Raster ? "raster" : "rays"; }
 
 void validateRig(const StereoRig& rig) {
   if (rig.width < 1 || rig.height < 1 || rig.width > kMaxEyeDimension || rig.height > kMaxEyeDimension)

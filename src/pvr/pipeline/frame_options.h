@@ -34,6 +34,13 @@ enum class DensityScheme : int {
 };
 const char* densitySchemeName(DensityScheme s);  ///< "pixel" | "cache"
 
+// Where the eye pass's first hits come from (sample 0, through the pixel centres).
+enum class PrimaryVisibility : int {
+  Rays = 0,    ///< traced
+  Raster = 1,  ///< Ray-VR's G-buffer pre-pass: both eyes rasterised by Vulkan (raster/gbuffer_raster.h)
+};
+const char* primaryVisibilityName(PrimaryVisibility p);  ///< "rays" | "raster"
+
 struct RenderOptions {
   uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
   int maxPhotonDepth = 8;
@@ -47,6 +54,7 @@ struct RenderOptions {
   DensityKernel kernel = DensityKernel::Hybrid;
   DensityScheme density = DensityScheme::PerPixel;
   float cacheCellFraction = kDefaultCacheCellFraction;  ///< the surface cache's cell side over the radius
+  PrimaryVisibility primary = PrimaryVisibility::Rays;
   GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
   bool eyes[2] = {true, true};
   StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading

@@ -15,6 +15,7 @@ const char* stageName(Stage stage) {
     case Stage::Reconstruct: return "foveated reconstruction";
     case Stage::Denoise: return "denoise";
     case Stage::Temporal: return "temporal resolve";
+    case Stage::Primary: return "raster pre-pass";
     case Stage::Count: break;
   }
   return "?";
@@ -24,6 +25,7 @@ const char* frameDataName(FrameData data) {
   switch (data) {
     case FrameData::Photons: return "photons";
     case FrameData::PhotonMap: return "photon map";
+    case FrameData::PrimaryHits: return "rasterised first hits";
     case FrameData::SourceSurfaces: return "source surfaces";
     case FrameData::ScatteredSurfaces: return "scattered surfaces";
     case FrameData::RenderedImage: return "rendered image";
@@ -40,6 +42,13 @@ const char* frameDataName(FrameData data) {
 }
 
 StageIO photonTraceIO() { return {Stage::PhotonTrace, {}, {{FrameData::Photons}}}; }
+StageIO primaryIO(const bool eyes[2]) {
+  StageIO io{Stage::Primary, {}, {}};
+  for (int e = 0; e < 2; ++e)
+    if (eyes[e]) io.writes.push_back({FrameData::PrimaryHits, e});
+  return io;
+}
+
 StageIO mapBuildIO() { return {Stage::MapBuild, {{FrameData::Photons}}, {{FrameData::PhotonMap}}}; }
 StageIO scatterIO() { return {Stage::Scatter, {{FrameData::SourceSurfaces}}, {{FrameData::ScatteredSurfaces}}}; }
 
@@ -47,6 +56,7 @@ StageIO eyePassIO(const EyePass& pass) {
   const int e = int(pass.eye);
   StageIO io{Stage::EyeRays, {{FrameData::PhotonMap}}, {{FrameData::RenderedImage, e}, {FrameData::InverseDepth, e}}};
   io.writes.push_back({pass.foveated() ? FrameData::SampleSpacing : FrameData::FirstHits, e});
+  if (pass.rasterPrimary) io.reads.push_back({FrameData::PrimaryHits, e});
   if (pass.role == StereoRole::Source) io.writes.push_back({FrameData::SourceSurfaces});
   if (pass.denoiseGuides && !pass.foveated()) io.writes.push_back({FrameData::DenoiseGuides, e});
   if (pass.role == StereoRole::Reuser) {
@@ -219,6 +229,12 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
     frame.mapBytes = backend.buildPhotonMap(options.map, options.gather.density.radius);
   }
 
+  const bool raster = options.primary == PrimaryVisibility::Raster;
+  if (raster) {
+    flow.run(primaryIO(options.eyes));
+    const EyeCamera eyes[2] = {rig.eye(Eye::Left), rig.eye(Eye::Right)};
+    backend.rasterizePrimary(eyes);
+  }
   const bool reusing = options.stereo != StereoMode::Separate;
   const FoveationMask* mask = options.foveation.mask;
   FoveationOptions foveation = options.foveation;  // the right eye's gaze may follow the left's
@@ -240,6 +256,7 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
     // TAA keeps the emitted part out of its history; the denoiser also needs the rest.
     pass.denoiseGuides = options.denoise.enabled || options.temporal.enabled;
     pass.stillFrames = stillFrames_;
+    pass.rasterPrimary = raster;
     pass.role = !reusing ? StereoRole::Alone : eye == Eye::Left ? StereoRole::Source : StereoRole::Reuser;
     if (pass.role == StereoRole::Reuser) {
       pass.reuse = options.stereo;
@@ -303,6 +320,7 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
   StageTimings& t = frame.timings;
   t.photonTraceMs = clock.ms(Stage::PhotonTrace, kWholeFrame);
   t.mapBuildMs = clock.ms(Stage::MapBuild, kWholeFrame);
+  t.primaryMs = clock.ms(Stage::Primary, kWholeFrame);
   t.scatterMs = clock.ms(Stage::Scatter, int(Eye::Right));
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;

@@ -13,6 +13,9 @@ namespace pvr {
 
 struct StageTimings {
   double photonTraceMs = 0, mapBuildMs = 0, eyeMs[2] = {0, 0};
+  // --primary raster: the G-buffer pre-pass of both eyes (GPU time of the Vulkan pass, or the
+  // host's wait for it on the CPU backend).
+  double primaryMs = 0;
   // Within an eye: eye rays (to the gather points) and density estimation; for the single
   // kernel everything is eye rays.
   double eyeRayMs[2] = {0, 0}, densityMs[2] = {0, 0};
@@ -25,7 +28,7 @@ struct StageTimings {
   double denoiseMs[2] = {0, 0};
   // TAA: resolving each eye's image against its history (in eyeMs).
   double temporalMs[2] = {0, 0};
-  double totalMs() const { return photonTraceMs + mapBuildMs + eyeMs[0] + eyeMs[1]; }
+  double totalMs() const { return photonTraceMs + mapBuildMs + primaryMs + eyeMs[0] + eyeMs[1]; }
 };
 
 struct EyeResult {

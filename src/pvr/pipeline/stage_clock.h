@@ -16,6 +16,7 @@ enum class Stage : int {
   Reconstruct,      ///< foveated: the image rebuilt from the mask's vertices
   Denoise,          ///< spatio-temporal denoising of the eye's image
   Temporal,         ///< TAA resolve against the eye's history
+  Primary,          ///< the G-buffer pre-pass: both eyes' first hits rasterised (--primary raster)
   Count,
 };
 
@@ -32,6 +33,8 @@ class StageClock {
   virtual void end(Stage stage, int eye) = 0;
   // The stage's time in this frame, in ms; only once the backend has finished the frame.
   virtual double ms(Stage stage, int eye) = 0;
+  // Adds a time measured elsewhere (another API's timestamps) to the stage's.
+  virtual void add(Stage stage, int eye, double ms) = 0;
 };
 
 // Times one stage for the scope's life.
@@ -60,6 +63,7 @@ class HostStageClock : public StageClock {
     totals_[s] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started_[s]).count();
   }
   double ms(Stage stage, int eye) override { return totals_[slot(stage, eye)]; }
+  void add(Stage stage, int eye, double ms) override { totals_[slot(stage, eye)] += ms; }
 
  private:
   static int slot(Stage stage, int eye) { return int(stage) * 3 + eye + 1; }

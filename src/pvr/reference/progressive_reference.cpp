@@ -17,6 +17,7 @@ ProgressiveReference::ProgressiveReference(FrameRenderer& renderer, const Stereo
     throw Error("the reference's alpha must be between 0 and 1 (exclusive), got " + std::to_string(settings.alpha));
   options_.stereo = StereoMode::Separate;
   options_.density = DensityScheme::PerPixel;  // an estimate per pixel: no cell's blur in the reference
+  options_.primary = PrimaryVisibility::Rays;   // the reference traces every ray it uses
   options_.foveation.mask = nullptr;
   options_.temporal.enabled = false;
   options_.denoise.enabled = false;

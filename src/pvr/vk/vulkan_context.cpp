@@ -143,12 +143,20 @@ VulkanContext::VulkanContext(const VulkanContextOptions& options) {
       extensions.push_back(VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME);
       extensions.push_back(VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME);
     }
+    VkPhysicalDeviceMultiviewFeatures multiview{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MULTIVIEW_FEATURES};
+    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    features.pNext = &multiview;
+    vkGetPhysicalDeviceFeatures2(physical_, &features);
+    multiview_ = multiview.multiview == VK_TRUE;
+    VkPhysicalDeviceMultiviewFeatures enabledMultiview{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MULTIVIEW_FEATURES};
+    enabledMultiview.multiview = VK_TRUE;
     float priority = 1.0f;
     VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
     qci.queueFamilyIndex = queueFamily_;
     qci.queueCount = 1;
     qci.pQueuePriorities = &priority;
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    if (multiview_) dci.pNext = &enabledMultiview;
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
     dci.enabledExtensionCount = uint32_t(extensions.size());
@@ -256,7 +264,10 @@ VkDeviceMemory allocate(const VulkanContext& vk, const VkMemoryRequirements& req
   return memory;
 }
 
-VulkanBuffer makeBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage, bool exportable) {
+enum class BufferKind { Host, Device, Exportable };
+
+VulkanBuffer makeBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage, BufferKind kind) {
+  const bool exportable = kind == BufferKind::Exportable;
   VulkanBuffer b;
   b.device = vk.device();
   b.size = size;
@@ -270,24 +281,28 @@ VulkanBuffer makeBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsag
   vkCheck(vkCreateBuffer(b.device, &bci, nullptr, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(b.device, b.buffer, &req);
-  b.memory = allocate(vk, req, exportable ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
-                                          : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                      exportable, b.buffer, VK_NULL_HANDLE, "eye buffer");
+  b.memory = allocate(vk, req, kind != BufferKind::Host ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
+                                                       : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                      exportable, b.buffer, VK_NULL_HANDLE, "buffer");
   b.allocationSize = req.size;
   vkCheck(vkBindBufferMemory(b.device, b.buffer, b.memory, 0), "vkBindBufferMemory");
-  if (!exportable) vkCheck(vkMapMemory(b.device, b.memory, 0, size, 0, &b.mapped), "vkMapMemory");
+  if (kind == BufferKind::Host) vkCheck(vkMapMemory(b.device, b.memory, 0, size, 0, &b.mapped), "vkMapMemory");
   return b;
 }
 
 }  // namespace
 
 VulkanBuffer makeHostBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage) {
-  return makeBuffer(vk, size, usage, false);
+  return makeBuffer(vk, size, usage, BufferKind::Host);
+}
+
+VulkanBuffer makeDeviceBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage) {
+  return makeBuffer(vk, size, usage, BufferKind::Device);
 }
 
 VulkanBuffer makeExportableBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage) {
   if (!vk.canShareWithCuda()) throw Error("the Vulkan device '" + vk.deviceName() + "' cannot share memory with CUDA");
-  return makeBuffer(vk, size, usage, true);
+  return makeBuffer(vk, size, usage, BufferKind::Exportable);
 }
 
 VulkanImage& VulkanImage::operator=(VulkanImage&& o) noexcept {
@@ -297,6 +312,7 @@ VulkanImage& VulkanImage::operator=(VulkanImage&& o) noexcept {
   std::swap(format, o.format);
   std::swap(width, o.width);
   std::swap(height, o.height);
+  std::swap(layers, o.layers);
   std::swap(allocationSize, o.allocationSize);
   return *this;
 }
@@ -309,17 +325,18 @@ VulkanImage::~VulkanImage() {
 
 namespace {
 
-VulkanImage createImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage, bool exportable) {
+VulkanImage createImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage,
+                        bool exportable, int layers) {
   VulkanImage img;
   img.device = vk.device();
   img.format = format;
-  img.width = width, img.height = height;
+  img.width = width, img.height = height, img.layers = layers;
   VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ici.imageType = VK_IMAGE_TYPE_2D;
   ici.format = format;
   ici.extent = {uint32_t(width), uint32_t(height), 1};
   ici.mipLevels = 1;
-  ici.arrayLayers = 1;
+  ici.arrayLayers = uint32_t(layers);
   ici.samples = VK_SAMPLE_COUNT_1_BIT;
   ici.tiling = VK_IMAGE_TILING_OPTIMAL;
   ici.usage = usage;
@@ -330,7 +347,7 @@ VulkanImage createImage(const VulkanContext& vk, int width, int height, VkFormat
   vkCheck(vkCreateImage(img.device, &ici, nullptr, &img.image), "vkCreateImage");
   VkMemoryRequirements req;
   vkGetImageMemoryRequirements(img.device, img.image, &req);
-  img.memory = allocate(vk, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, exportable, VK_NULL_HANDLE, img.image, "eye image");
+  img.memory = allocate(vk, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, exportable, VK_NULL_HANDLE, img.image, "image");
   img.allocationSize = req.size;
   vkCheck(vkBindImageMemory(img.device, img.image, img.memory, 0), "vkBindImageMemory");
   return img;
@@ -338,13 +355,14 @@ VulkanImage createImage(const VulkanContext& vk, int width, int height, VkFormat
 
 }  // namespace
 
-VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage) {
-  return createImage(vk, width, height, format, usage, false);
+VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage,
+                      int layers) {
+  return createImage(vk, width, height, format, usage, false, layers);
 }
 
 VulkanImage makeExportableImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage) {
   if (!vk.canShareWithCuda()) throw Error("the Vulkan device '" + vk.deviceName() + "' cannot share memory with CUDA");
-  return createImage(vk, width, height, format, usage, true);
+  return createImage(vk, width, height, format, usage, true, 1);
 }
 
 void transitionImage(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to) {

@@ -58,6 +58,8 @@ class VulkanContext {
   const uint8_t* deviceUuid() const { return uuid_; }
   // VK_KHR_external_memory_fd and VK_KHR_external_semaphore_fd are enabled: CUDA can share memory.
   bool canShareWithCuda() const { return externalFd_; }
+  // Multiview (both eyes in one render pass: the G-buffer pre-pass) is enabled where the device has it.
+  bool hasMultiview() const { return multiview_; }
 
   // A memory type with these bits among `typeBits`; throws if there is none.
   uint32_t memoryType(uint32_t typeBits, VkMemoryPropertyFlags flags) const;
@@ -72,7 +74,7 @@ class VulkanContext {
   VkCommandPool pool_ = VK_NULL_HANDLE;
   uint32_t queueFamily_ = 0;
   std::string deviceName_;
-  bool cpuDevice_ = false, externalFd_ = false;
+  bool cpuDevice_ = false, externalFd_ = false, multiview_ = false;
   uint8_t uuid_[16] = {};
 };
 
@@ -90,6 +92,8 @@ struct VulkanBuffer {
 };
 // Host-visible and coherent, mapped: the CPU writes, the GPU copies.
 VulkanBuffer makeHostBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage);
+// Device-local, for the GPU alone (filled by copies).
+VulkanBuffer makeDeviceBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage);
 // Device-local, exportable as an opaque file descriptor (CUDA imports it): needs canShareWithCuda.
 VulkanBuffer makeExportableBuffer(const VulkanContext& vk, VkDeviceSize size, VkBufferUsageFlags usage);
 
@@ -98,14 +102,16 @@ struct VulkanImage {
   VkImage image = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
-  int width = 0, height = 0;
+  int width = 0, height = 0, layers = 1;
   VkDeviceSize allocationSize = 0;
   VulkanImage() = default;
   VulkanImage(VulkanImage&& other) noexcept { *this = std::move(other); }
   VulkanImage& operator=(VulkanImage&& other) noexcept;
   ~VulkanImage();
 };
-VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage);
+// `layers` > 1: an array image (one layer per view of a multiview pass).
+VulkanImage makeImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage,
+                      int layers = 1);
 // Device-local, optimal tiling, exportable as an opaque file descriptor (CUDA maps it as an array).
 VulkanImage makeExportableImage(const VulkanContext& vk, int width, int height, VkFormat format, VkImageUsageFlags usage);
 
