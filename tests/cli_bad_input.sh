@@ -77,6 +77,10 @@ expect_error "--density must be pixel or cache" render cornell --backend cpu --d
 expect_error "--cache-cell: the surface cache's cell must be between" render cornell --backend cpu --density cache --cache-cell 2 "${small[@]}"
 expect_error "--cache-cell: the surface cache's cell must be between" render cornell --backend cpu --density cache --cache-cell nan "${small[@]}"
 expect_error "--density: the surface cache shades full-resolution eyes" render cornell --backend cpu --density cache --foveated "${small[@]}"
+expect_error "--primary must be rays or raster" render cornell --backend cpu --primary gbuffer "${small[@]}"
+# The pre-pass without any Vulkan driver (the loader finds none): one line, before any frame.
+VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json \
+  expect_error "--primary raster: no Vulkan driver found" render cornell --backend cpu --primary raster "${small[@]}"
 expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty
 expect_error "--reference-passes must be between 2" bench --suite quality --reference-passes 1 --backend cpu
 expect_error "--suite must be" bench --suite speed

@@ -242,6 +242,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
   vs.taa = o.temporal.enabled;
   vs.taaBlend = o.temporal.taa.blend;
   vs.denoise = o.denoise.enabled;
+  vs.rasterPrimary = o.primary == PrimaryVisibility::Raster;
   vs.exposure = args.exposure;
   vs.bothEyes = o.eyes[1];
   BackendKind kind = setup.backend;
@@ -274,6 +275,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                         {"acuity", s.acuity ? "geisler-perry" : "linear"},
                         {"taa", s.taa},
                         {"denoise", s.denoise},
+                        {"primary", s.rasterPrimary ? "raster" : "rays"},
                         {"exposure", s.exposure},
                         {"eye_size", std::to_string(rig0.width) + "x" + std::to_string(rig0.height)},
                         {"gaze", gaze},

@@ -240,6 +240,7 @@ struct ViewerPresenter::Impl {
         const StageTimings& t = frame->result->timings;
         ImGui::Text("%s, %s", frame->renderer.backendName().c_str(), frame->renderer.deviceName().c_str());
         ImGui::Text("%.2f ms: trace %.2f, map %.2f, eyes %.2f + %.2f", t.totalMs(), t.photonTraceMs, t.mapBuildMs, t.eyeMs[0], t.eyeMs[1]);
+        if (t.primaryMs > 0) ImGui::Text("raster pre-pass %.2f ms", t.primaryMs);
       }
       static const char* plotNames[] = {"frame", "photon trace", "map build", "left eye", "right eye"};
       for (int p = 0; p < 5; ++p)
@@ -263,6 +264,7 @@ struct ViewerPresenter::Impl {
       ImGui::Checkbox("TAA", &settings.taa);
       if (settings.taa) ImGui::SliderFloat("TAA blend", &settings.taaBlend, 0.02f, 1.0f);
       ImGui::Checkbox("denoise", &settings.denoise);
+      ImGui::Checkbox("raster pre-pass", &settings.rasterPrimary);
       ImGui::SliderFloat("exposure", &settings.exposure, 0.1f, 8.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
       ImGui::Checkbox("both eyes (Tab)", &settings.bothEyes);
       ImGui::Separator();
@@ -509,6 +511,7 @@ void ViewerPresenter::adjustOptions(RenderOptions& o) {
   if (s.taa != a.taa) o.temporal.enabled = s.taa;
   if (s.taaBlend != a.taaBlend) o.temporal.taa.blend = s.taaBlend;
   if (s.denoise != a.denoise) o.denoise.enabled = s.denoise;
+  if (s.rasterPrimary != a.rasterPrimary) o.primary = s.rasterPrimary ? PrimaryVisibility::Raster : PrimaryVisibility::Rays;
   if (s.foveated != a.foveated || (s.foveated && s.acuity != a.acuity)) {
     if (s.foveated) {
       MaskParams params = maskParamsForRig(m.rig);

@@ -27,6 +27,7 @@ struct ViewerSettings {
   bool taa = false;
   float taaBlend = 0.1f;
   bool denoise = false;
+  bool rasterPrimary = false;      ///< --primary raster (the G-buffer pre-pass)
   float exposure = 1.0f;
   int backend = 0;                 ///< 0 cpu, 1 cuda
   bool bothEyes = true;
