@@ -629,3 +629,36 @@ TEST(GpuBackend, RasterPrePassMatchesTracedFirstHits) {
 
 }  // namespace
 }  // namespace pvr
+
+namespace pvr {
+namespace {
+
+// Every effect level on the GPU against the CPU (the same random numbers, the same shared code):
+// the caustics box (mirror and glass), the textured, alpha-cut and punctually lit box, and the
+// microfacet box under a sky; the path level too, whose paths only diverge where rounding flips a
+// Russian-roulette or lobe choice.
+TEST(GpuBackend, EffectLevelsMatchTheCpu) {
+  PVR_REQUIRE_GPU();
+  Scene scenes[3] = {builtinScene("cornell-caustics"), texturedLitCornell(), microfacetSkyCornell()};
+  for (const Scene& scene : scenes)
+    for (int l = 0; l < kEffectLevels; ++l) {
+      RenderOptions o = comparisonOptions();
+      o.gather.overrideEffects = true;
+      o.gather.effects = EffectLevel(l);
+      StereoRig rig = scene.rig;
+      rig.width = 160, rig.height = 176;
+      FrameRenderer cpu(makeCpuFrameRenderer(scene)), gpu(makeCudaFrameRenderer(scene));
+      for (DensityKernel kernel : {DensityKernel::Hybrid, DensityKernel::Single}) {
+        o.kernel = kernel;
+        FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
+        ImageCheck c = compare(a, b);
+        const std::string what = scene.name + ", " + effectLevelName(EffectLevel(l)) + ", " + densityKernelName(kernel);
+        EXPECT_LT(c.relativeMad, l == int(EffectLevel::Path) ? 0.03 : 0.01) << what;
+        EXPECT_LT(c.outliers, l == int(EffectLevel::Path) ? 0.05 : 0.005) << what;
+        EXPECT_GT(c.firstPrimAgree, 0.995) << what;
+      }
+    }
+}
+
+}  // namespace
+}  // namespace pvr

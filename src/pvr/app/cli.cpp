@@ -75,6 +75,7 @@ struct RenderArgs {
   std::string density = "pixel";
   std::string cacheCell;  // empty: kDefaultCacheCellFraction
   std::string primary = "rays";
+  std::string effects;  // empty: each material's own level (the scene's "effect"s)
   std::string backend = "auto";
   std::string stereo = "separate";
   int k = 32;
@@ -133,6 +134,7 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     text("density", "--density", a.density);
     text("cache_cell", "--cache-cell", a.cacheCell);
     text("primary", "--primary", a.primary);
+    text("effects", "--effects", a.effects);
     text("backend", "--backend", a.backend);
     text("stereo", "--stereo", a.stereo);
     text("eye_size", "--eye-size", a.eyeSize);
@@ -193,6 +195,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
                  "First hits of the eye rays: rays (traced) | raster (Ray-VR's G-buffer pre-pass: both eyes rasterised "
                  "by Vulkan in one multiview pass, on the CUDA GPU or, for the CPU backend, any Vulkan device)")
       ->capture_default_str();
+  cmd.add_option("--effects", a.effects,
+                 "Ray-VR's effect level for every material, overriding the scene's: raster (direct light, no shadows) | "
+                 "shadows | reflections (mirrors, glass, glossy followed) | gi (photon-mapped, the default) | path "
+                 "(indirect light path traced)");
   cmd.add_option("--backend", a.backend, "cpu (Embree + TBB reference) | cuda | auto (cuda if a GPU is present)")
       ->capture_default_str();
   cmd.add_option("--stereo", a.stereo,
@@ -270,6 +276,11 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   if (a.primary == "rays") o.primary = PrimaryVisibility::Rays;
   else if (a.primary == "raster") o.primary = PrimaryVisibility::Raster;
   else throw Error("--primary must be rays or raster, got '" + a.primary + "'");
+  if (!a.effects.empty()) {
+    if (!effectLevelFromName(a.effects, o.gather.effects))
+      throw Error("--effects must be raster, shadows, reflections, gi or path, got '" + a.effects + "'");
+    o.gather.overrideEffects = true;
+  }
   o.stereo = parseStereoMode(a.stereo);
   if (a.eyes == "both") o.eyes[0] = o.eyes[1] = true;
   else if (a.eyes == "left") o.eyes[0] = true, o.eyes[1] = false;
@@ -404,7 +415,8 @@ int runRender(const RenderArgs& a) {
   std::printf("  photon trace  %9.2f ms  (%zu photons stored)\n", frame.timings.photonTraceMs, frame.storedPhotons);
   std::printf("  map build     %9.2f ms  (%.1f MiB)\n", frame.timings.mapBuildMs, frame.mapBytes / 1048576.0);
   if (options.primary == PrimaryVisibility::Raster)
-    std::printf("  raster pass   %9.2f ms  (both eyes' first hits, Vulkan multiview)\n", frame.timings.primaryMs);
+    std::printf("  raster pass   %9.2f ms  (both eyes' first hits by Vulkan; %.2f ms drawing, the rest copying)\n",
+                frame.timings.primaryMs, frame.timings.primaryDrawMs);
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;
     std::printf("  %-5s eye     %9.2f ms  (eye rays %.2f, density %.2f", names[e], frame.timings.eyeMs[e],

@@ -67,6 +67,7 @@ nlohmann::json describeRun(const Renderer& renderer, const LoopSetup& setup, con
           {"kernel", densityKernelName(o.kernel)},
           {"density", densitySchemeName(o.density)},
           {"primary", primaryVisibilityName(o.primary)},
+          {"effects", o.gather.overrideEffects ? effectLevelName(o.gather.effects) : "per material"},
           {"foveated", o.foveation.mask != nullptr},
           {"taa", o.temporal.enabled},
           {"denoise", o.denoise.enabled}};
@@ -243,6 +244,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
   vs.taaBlend = o.temporal.taa.blend;
   vs.denoise = o.denoise.enabled;
   vs.rasterPrimary = o.primary == PrimaryVisibility::Raster;
+  vs.effects = o.gather.overrideEffects ? 1 + int(o.gather.effects) : 0;
   vs.exposure = args.exposure;
   vs.bothEyes = o.eyes[1];
   BackendKind kind = setup.backend;
@@ -276,6 +278,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                         {"taa", s.taa},
                         {"denoise", s.denoise},
                         {"primary", s.rasterPrimary ? "raster" : "rays"},
+                        {"effects", s.effects > 0 ? effectLevelName(EffectLevel(s.effects - 1)) : ""},
                         {"exposure", s.exposure},
                         {"eye_size", std::to_string(rig0.width) + "x" + std::to_string(rig0.height)},
                         {"gaze", gaze},

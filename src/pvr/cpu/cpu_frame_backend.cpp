@@ -24,6 +24,7 @@ void CpuFrameBackend::rasterizePrimary(const EyeCamera eyes[2]) {
   }
   raster_->render(eyes);
   raster_->waitDone();
+  raster_->lastGpuMs(&counters_.primaryDrawMs);
   rasterised_ = true;
 }
 

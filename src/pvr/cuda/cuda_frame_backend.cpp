@@ -293,7 +293,8 @@ FrameCounters CudaFrameBackend::finishFrame() {
     m.raster.readersSignalled = true;
   }
   PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));  // also surfaces the frame's faults, if any
-  if (m.frame.rasterised) m.clock->add(Stage::Primary, kWholeFrame, m.raster.pass->lastGpuMs());
+  double rasterDrawMs = 0.0;
+  if (m.frame.rasterised) m.clock->add(Stage::Primary, kWholeFrame, m.raster.pass->lastGpuMs(&rasterDrawMs));
   FrameCounters c;
   if (m.frame.cached) c.cacheCells = m.surfaceCache.cells(), c.cacheUnplaced = m.surfaceCache.unplacedPoints();
   for (int e = 0; e < 2; ++e) {
@@ -302,6 +303,7 @@ FrameCounters CudaFrameBackend::finishFrame() {
     c.historyPixels[e] = historyPixels[e];
   }
   c.reusedSamples = reused;
+  c.primaryDrawMs = rasterDrawMs;
   c.deviceBytes = cuda::deviceBytesInUse();
   return c;
 }

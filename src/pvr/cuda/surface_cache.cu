@@ -32,7 +32,7 @@ __global__ void insertKernel(SurfaceCacheView cache, GatherPointStore points, ui
   uint64_t key = kNoSurfaceCell;
   SurfaceCellSums sums{};
   if (i < n) {
-    const GatherPointCore c = points.core[i];
+    const GatherPointCore c = points.coreAt(i);
     if (cachesEstimate(c.lobes, c.weight)) {
       int cell[3];
       key = surfaceCellKeyOf(cache, c.position, c.normal, cell);

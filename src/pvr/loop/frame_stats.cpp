@@ -54,6 +54,7 @@ nlohmann::json FrameStats::toJson() const {
            {{"photon_trace", stage([](const StageTimings& t) { return t.photonTraceMs; })},
             {"map_build", stage([](const StageTimings& t) { return t.mapBuildMs; })},
             {"raster_prepass", stage([](const StageTimings& t) { return t.primaryMs; })},
+            {"raster_draw", stage([](const StageTimings& t) { return t.primaryDrawMs; })},
             {"left_eye_rays", stage([](const StageTimings& t) { return t.eyeRayMs[0]; })},
             {"right_eye_rays", stage([](const StageTimings& t) { return t.eyeRayMs[1]; })},
             {"left_eye", stage([](const StageTimings& t) { return t.eyeMs[0]; })},

@@ -10,7 +10,7 @@
 //    formulation; the map then holds every photon including the direct ones).
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/photon/density.h"
-#include "pvr/raster/primary_hits.h"
+#include "pvr/shading/primary_hits.h"
 #include "pvr/shading/scene_view.h"
 #include "pvr/stereo/stereo_reuse.h"
 #include "pvr/util/rng.h"
@@ -33,6 +33,20 @@ struct GatherParams {
   // Sample 0's first hits rasterised (the G-buffer pre-pass), set by the backend for one eye pass;
   // none: traced. Ignored when the first sample is jittered.
   PrimaryHitsView primary;
+  // Every material's effect level replaced by `effects` (else each surface's own, Material::effect).
+  bool overrideEffects = false;
+  EffectLevel effects = EffectLevel::Gi;
+  int pathDepth = 8;  ///< EffectLevel::Path: bounces of its indirect paths (Russian roulette after 3)
+};
+
+// The effect level the eye paths use at a surface of material m.
+PVR_HOST_DEVICE inline EffectLevel effectLevelOf(const GatherParams& params, const Material& m) {
+  return params.overrideEffects ? params.effects : m.effect;
+}
+
+// Shadow rays that always reach their light: EffectLevel::Raster's direct light.
+struct NoOccluders {
+  PVR_HOST_DEVICE bool occluded(const Ray&, float) const { return false; }
 };
 
 // One pixel's result. Sample 0 (the centre ray) decides everything but the radiance.
@@ -189,6 +203,90 @@ PVR_HOST_DEVICE Vec3 skyDirectLight(const SceneView& scene, const Intersector& i
   return bsdf(wi) * scene.sky.radiance * kPi;
 }
 
+// Direct light at a Lambertian surface point: the punctual, area and sky lights' estimators, in
+// that order (the random numbers are drawn the same way at every effect level).
+template <class Intersector, class Bsdf>
+PVR_HOST_DEVICE Vec3 diffuseDirectLight(const SceneView& scene, const Intersector& intersector, const GatherParams& params,
+                                        Vec3 position, Vec3 nGeo, Vec3 nShade, float eps, const Bsdf& bsdf,
+                                        CounterRng& rng) {
+  Vec3 sum = punctualDirectLight(scene, intersector, position, nGeo, nShade, false, eps, bsdf, params.punctualShadowRays, rng);
+  if (scene.triangleLightCount > 0) sum += areaDirectLight(scene, intersector, position, nGeo, nShade, eps, rng, bsdf);
+  if (scene.sky.present()) sum += skyDirectLight(scene, intersector, position, nGeo, nShade, eps, rng, bsdf);
+  return sum;
+}
+
+// EffectLevel::Path's indirect light: the radiance arriving along `ray` (leaving a surface whose
+// direct light was estimated by shadow rays) from a path traced onwards. Each diffuse or glossy
+// vertex adds its direct light by the shadow-ray estimators (next-event estimation), so emission
+// the path finds counts only after a mirror or glass bounce. Russian roulette after 3 bounces.
+template <class Intersector>
+PVR_HOST_DEVICE Vec3 pathTracedRadiance(const SceneView& scene, const Intersector& intersector, const GatherParams& params,
+                                        Ray ray, CounterRng& rng) {
+  Vec3 sum{0, 0, 0}, throughput{1, 1, 1};
+  const float eps = scene.rayEpsilon();
+  bool countEmission = false;
+  for (int bounce = 0; bounce < params.pathDepth; ++bounce) {
+    Hit hit;
+    intersector.intersect(ray, INFINITY, hit);
+    if (!hit.valid()) {
+      if (countEmission) sum += throughput * scene.sky.along(ray.dir);
+      break;
+    }
+    const SurfacePoint sp = scene.surfacePoint(hit);
+    const Material& m = scene.materials[sp.materialId];
+    const float cosIn = dot(ray.dir, sp.geometricNormal);
+    const bool front = cosIn < 0.0f;
+    if (countEmission && front && m.isEmissive())
+      sum += throughput * scene.emissionAt(m, hit.primId, hit.u, hit.v, 0.0f, cosIn);
+    const Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
+    if (m.type == MaterialType::Diffuse) {
+      const Vec3 nShade = front ? sp.shadingNormal : -sp.shadingNormal;
+      const Vec3 albedo = scene.albedoAt(m, hit.primId, hit.u, hit.v, 0.0f, dot(ray.dir, nGeo));
+      const Vec3 brdf = albedo * kInvPi;
+      sum += throughput * diffuseDirectLight(scene, intersector, params, sp.position, nGeo, nShade, eps,
+                                             [&](Vec3) { return brdf; }, rng);
+      // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+      float u1 = rng.uniform();
+      float u2 = rng.uniform();
+      const Vec3 wi = Frame::fromNormal(nShade).toWorld(sampleCosineHemisphere(u1, u2));
+      if (!(dot(wi, nGeo) > 0.0f)) break;
+      throughput *= albedo;  // f cos / pdf of cosine sampling
+      ray = Ray{sp.position + nGeo * eps, wi};
+      countEmission = false;
+    } else if (m.type == MaterialType::Microfacet) {
+      const Vec3 wo = -ray.dir;
+      const BsdfParams b = scene.bsdfAt(m, hit, sp, wo, 0.0f);
+      auto bsdf = [&](Vec3 wi) { return b.eval(wo, wi); };
+      sum += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, b.normal, m.transmits(), eps, bsdf,
+                                              params.punctualShadowRays, rng);
+      if (scene.triangleLightCount > 0)
+        sum += throughput * areaDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, bsdf);
+      if (scene.sky.present())
+        sum += throughput * skyDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, bsdf);
+      // Three statements: the order of evaluation of arguments differs between g++ and nvcc.
+      float uLobe = rng.uniform();
+      float u1 = rng.uniform();
+      float u2 = rng.uniform();
+      const BsdfSample bs = sampleBsdf(b, wo, uLobe, u1, u2);
+      if (!bs.valid()) break;
+      throughput *= bs.weight;
+      ray.dir = bs.wi;
+      ray.origin = sp.position + (dot(bs.wi, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal) * eps;
+      countEmission = false;
+    } else {
+      ray.dir = scatterSpecular(m, ray.dir, sp.shadingNormal, rng.uniform(), throughput);
+      ray.origin = sp.position + (dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal) * eps;
+      countEmission = true;  // a delta bounce: no shadow ray counted what it finds
+    }
+    if (bounce >= 2) {
+      const float survive = fminf(0.95f, maxComponent(throughput));
+      if (!(rng.uniform() < survive)) break;
+      throughput *= 1.0f / survive;
+    }
+  }
+  return sum;
+}
+
 // Follows the eye ray through mirrors and glass to a surface that gathers from the photon map.
 // `firstHit`, if given, is the ray's first intersection, already traced. `coneSpread` is the ray
 // cone's width per unit distance (a pixel's, for camera rays): it chooses the textures' level of
@@ -199,6 +297,12 @@ PVR_HOST_DEVICE Vec3 skyDirectLight(const SceneView& scene, const Intersector& i
 // gathered there: direct light by shadow rays, the rest from the photon map with the BSDF. One
 // random choice between the two, by the lobes' probabilities, keeps one gather point per path and
 // is unbiased. Punctual lights are evaluated with the whole BSDF at every such surface.
+//
+// The surface's effect level (effectLevelOf) trims this: below Reflections nothing is followed
+// (mirrors and glass are shaded as Lambertian surfaces of their tint), Raster's direct light casts
+// no shadows, only Gi leaves an estimate to the photon map, and Path traces the indirect light.
+// Below Gi the point carries no estimate (weight zero) even under ShadingMode::PhotonMapOnly,
+// whose direct light then comes from shadow rays.
 template <class Intersector>
 PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Intersector& intersector,
                                                const GatherParams& params, Ray ray, CounterRng& rng,
@@ -228,19 +332,31 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
       out.emitted += e;
     }
     Vec3 nGeo = front ? sp.geometricNormal : -sp.geometricNormal;
-    if (m.type == MaterialType::Diffuse) {
+    const EffectLevel level = effectLevelOf(params, m);
+    const bool direct = full || level != EffectLevel::Gi;  // photon-map-only Gi leaves direct light to the map
+    const bool unshadowed = level == EffectLevel::Raster;
+    const bool followNothing = level < EffectLevel::Reflections;
+    if (m.type == MaterialType::Diffuse || (m.isSpecular() && followNothing)) {
       Vec3 nShade = front ? sp.shadingNormal : -sp.shadingNormal;
-      Vec3 brdf = scene.albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo)) * kInvPi;
+      const Vec3 albedo = m.type == MaterialType::Diffuse
+                              ? scene.albedoAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo))
+                              : m.albedo;
+      Vec3 brdf = albedo * kInvPi;
       auto lambertian = [&](Vec3) { return brdf; };
-      if (full) {
-        out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, nShade, false, eps, lambertian,
-                                                                 params.punctualShadowRays, rng);
-        if (scene.triangleLightCount > 0)
-          out.radiance += throughput * areaDirectLight(scene, intersector, sp.position, nGeo, nShade, eps, rng, lambertian);
-        if (scene.sky.present())
-          out.radiance += throughput * skyDirectLight(scene, intersector, sp.position, nGeo, nShade, eps, rng, lambertian);
+      if (direct && unshadowed)
+        out.radiance += throughput * diffuseDirectLight(scene, NoOccluders(), params, sp.position, nGeo, nShade, eps, lambertian, rng);
+      else if (direct)
+        out.radiance += throughput * diffuseDirectLight(scene, intersector, params, sp.position, nGeo, nShade, eps, lambertian, rng);
+      if (level == EffectLevel::Gi)
+        out.weight = throughput * brdf * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
+      if (level == EffectLevel::Path) {
+        // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+        float u1 = rng.uniform();
+        float u2 = rng.uniform();
+        const Vec3 wi = Frame::fromNormal(nShade).toWorld(sampleCosineHemisphere(u1, u2));
+        if (dot(wi, nGeo) > 0.0f)  // f cos / pdf of cosine sampling: the albedo
+          out.radiance += throughput * albedo * pathTracedRadiance(scene, intersector, params, Ray{sp.position + nGeo * eps, wi}, rng);
       }
-      out.weight = throughput * brdf * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
       out.position = sp.position;
       out.normal = nGeo;
       break;
@@ -248,11 +364,15 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
     if (m.type == MaterialType::Microfacet) {
       const Vec3 wo = -ray.dir;
       const BsdfParams b = scene.bsdfAt(m, hit, sp, wo, coneWidth);
-      if (full)
+      auto bsdf = [&](Vec3 wi) { return b.eval(wo, wi); };
+      if (direct && unshadowed)
+        out.radiance += throughput * punctualDirectLight(scene, NoOccluders(), sp.position, nGeo, b.normal, m.transmits(), eps,
+                                                         bsdf, params.punctualShadowRays, rng);
+      else if (direct)
         out.radiance += throughput * punctualDirectLight(scene, intersector, sp.position, nGeo, b.normal, m.transmits(), eps,
-                                                         [&](Vec3 wi) { return b.eval(wo, wi); }, params.punctualShadowRays,
-                                                         rng);
-      const uint32_t followed = kLobeTransmission | (b.alpha < kGatheredMinAlpha ? uint32_t(kLobeReflection) : 0u);
+                                                         bsdf, params.punctualShadowRays, rng);
+      const uint32_t followed =
+          followNothing ? 0u : kLobeTransmission | (b.alpha < kGatheredMinAlpha ? uint32_t(kLobeReflection) : 0u);
       float p[3];
       b.lobeProbabilities(dot(b.normal, wo), kLobesAll, p);
       const float pFollow = ((followed & kLobeReflection) ? p[1] : 0.0f) + p[2];
@@ -262,11 +382,29 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
         const uint32_t gathered = kLobesAll & ~followed;
         const Vec3 scale = throughput * (1.0f / (1.0f - pFollow));
         auto gatheredBsdf = [&](Vec3 wi) { return b.eval(wo, wi, gathered); };
-        if (full && scene.triangleLightCount > 0)
-          out.radiance += scale * areaDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
-        if (full && scene.sky.present())
-          out.radiance += scale * skyDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
-        out.weight = scale * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
+        if (direct && unshadowed) {
+          if (scene.triangleLightCount > 0)
+            out.radiance += scale * areaDirectLight(scene, NoOccluders(), sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
+          if (scene.sky.present())
+            out.radiance += scale * skyDirectLight(scene, NoOccluders(), sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
+        } else if (direct) {
+          if (scene.triangleLightCount > 0)
+            out.radiance += scale * areaDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
+          if (scene.sky.present())
+            out.radiance += scale * skyDirectLight(scene, intersector, sp.position, nGeo, b.normal, eps, rng, gatheredBsdf);
+        }
+        if (level == EffectLevel::Path) {
+          // Three statements: the order of evaluation of arguments differs between g++ and nvcc.
+          float uLobe = rng.uniform();
+          float u1 = rng.uniform();
+          float u2 = rng.uniform();
+          const BsdfSample bs = sampleBsdf(b, wo, uLobe, u1, u2, gathered);
+          if (bs.valid()) {
+            const Vec3 side = dot(bs.wi, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
+            out.radiance += scale * bs.weight * pathTracedRadiance(scene, intersector, params, Ray{sp.position + side * eps, bs.wi}, rng);
+          }
+        }
+        if (level == EffectLevel::Gi) out.weight = scale * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
         out.position = sp.position;
         out.normal = nGeo;
         out.lobes = gathered;

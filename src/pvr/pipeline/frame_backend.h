@@ -154,6 +154,7 @@ struct FrameCounters {
   size_t deviceBytes = 0;             ///< GPU memory held (0 on the CPU)
   size_t cacheCells = 0;              ///< the surface cache's cells this frame (both eyes)
   size_t cacheUnplaced = 0;           ///< points whose cell found no slot in the cache (estimated on their own)
+  double primaryDrawMs = 0;           ///< the G-buffer pre-pass's raster passes, GPU time (timestamps)
 };
 
 class FrameBackend {

@@ -47,6 +47,10 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
   if (o.gather.samplesPerPixel < 1 || o.gather.samplesPerPixel > kMaxSamplesPerPixel)
     throw OptionError(RenderOption::SamplesPerPixel,
                       "samples per pixel must be between 1 and " + std::to_string(kMaxSamplesPerPixel));
+  if (o.gather.pathDepth < 1 || o.gather.pathDepth > kMaxPathDepth)
+    throw OptionError(RenderOption::SpecularDepth, "the path level's depth must be between 1 and " + std::to_string(kMaxPathDepth));
+  if (o.gather.overrideEffects && int(o.gather.effects) >= kEffectLevels)
+    throw OptionError(RenderOption::SpecularDepth, "unknown effect level " + std::to_string(int(o.gather.effects)));
   if (o.gather.maxSpecularDepth < 0 || o.gather.maxSpecularDepth > kMaxPathDepth)
     throw OptionError(RenderOption::SpecularDepth, "the specular depth must be between 0 and " + std::to_string(kMaxPathDepth));
   if (o.gather.punctualShadowRays < 0 || o.gather.punctualShadowRays > kMaxShadowRays)

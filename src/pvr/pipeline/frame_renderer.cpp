@@ -321,6 +321,7 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
   t.photonTraceMs = clock.ms(Stage::PhotonTrace, kWholeFrame);
   t.mapBuildMs = clock.ms(Stage::MapBuild, kWholeFrame);
   t.primaryMs = clock.ms(Stage::Primary, kWholeFrame);
+  t.primaryDrawMs = counters.primaryDrawMs;
   t.scatterMs = clock.ms(Stage::Scatter, int(Eye::Right));
   for (int e = 0; e < 2; ++e) {
     if (!options.eyes[e]) continue;

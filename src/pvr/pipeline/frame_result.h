@@ -16,6 +16,7 @@ struct StageTimings {
   // --primary raster: the G-buffer pre-pass of both eyes (GPU time of the Vulkan pass, or the
   // host's wait for it on the CPU backend).
   double primaryMs = 0;
+  double primaryDrawMs = 0;  ///< of primaryMs, the raster passes (the rest: copying their targets into the shared buffer)
   // Within an eye: eye rays (to the gather points) and density estimation; for the single
   // kernel everything is eye rays.
   double eyeRayMs[2] = {0, 0}, densityMs[2] = {0, 0};

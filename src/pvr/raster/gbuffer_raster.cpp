@@ -333,7 +333,7 @@ GBufferRaster::GBufferRaster(VulkanContext& vk, const Scene& scene, bool shareWi
     vkCheck(vkCreateFence(s.device, &fci, nullptr, &s.fence), "vkCreateFence");
     VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qci.queryCount = 2;
+    qci.queryCount = 3;
     vkCheck(vkCreateQueryPool(s.device, &qci, nullptr, &s.timestamps), "vkCreateQueryPool");
     uint32_t families = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(vk.physicalDevice(), &families, nullptr);
@@ -412,7 +412,7 @@ void GBufferRaster::render(const EyeCamera eyes[2], bool waitForReaders) {
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   vkCheck(vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
-  vkCmdResetQueryPool(cmd, s.timestamps, 0, 2);
+  vkCmdResetQueryPool(cmd, s.timestamps, 0, 3);
   vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.timestamps, 0);
   VkClearValue clears[3] = {};
   clears[0].color.uint32[0] = ~0u;  // no triangle: the sky
@@ -440,6 +440,7 @@ void GBufferRaster::render(const EyeCamera eyes[2], bool waitForReaders) {
     vkCmdDraw(cmd, 3 * s.triangles, 1, 0, 0);
     vkCmdEndRenderPass(cmd);
   }
+  vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_GRAPHICS_BIT, s.timestamps, 1);
   // Both views of each target into the buffer, planes as primary_hits.h reads them.
   const VkDeviceSize pixels = VkDeviceSize(width_) * VkDeviceSize(height_);
   VkBufferImageCopy region{};
@@ -454,7 +455,7 @@ void GBufferRaster::render(const EyeCamera eyes[2], bool waitForReaders) {
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
                        shared_ ? VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT : VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &written, 0,
                        nullptr, 0, nullptr);
-  vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.timestamps, 1);
+  vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.timestamps, 2);
   vkCheck(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
 
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
@@ -485,15 +486,17 @@ PrimaryHitsView GBufferRaster::hostView(Eye eye) const {
   return v;
 }
 
-double GBufferRaster::lastGpuMs() {
+double GBufferRaster::lastGpuMs(double* drawMs) {
   Impl& s = *impl_;
   if (!s.submitted || s.timestampMask == 0) return 0.0;
   waitDone();
-  uint64_t t[2] = {0, 0};
-  VkResult r = vkGetQueryPoolResults(s.device, s.timestamps, 0, 2, sizeof(t), t, sizeof(uint64_t),
+  uint64_t t[3] = {0, 0, 0};
+  VkResult r = vkGetQueryPoolResults(s.device, s.timestamps, 0, 3, sizeof(t), t, sizeof(uint64_t),
                                      VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
   if (r != VK_SUCCESS) return 0.0;
-  return double((t[1] - t[0]) & s.timestampMask) * s.timestampPeriodNs * 1e-6;
+  const double toMs = s.timestampPeriodNs * 1e-6;
+  if (drawMs) *drawMs = double((t[1] - t[0]) & s.timestampMask) * toMs;
+  return double((t[2] - t[0]) & s.timestampMask) * toMs;
 }
 
 int GBufferRaster::exportBufferFd() const {

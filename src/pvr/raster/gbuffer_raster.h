@@ -14,8 +14,8 @@
 #include <string>
 
 #include "pvr/camera/stereo_rig.h"
-#include "pvr/raster/primary_hits.h"
-#include "pvr/vk/vulkan_context.h"
+#include "pvr/shading/primary_hits.h"
+#include "pvr/vulkan/vulkan_context.h"
 
 namespace pvr {
 
@@ -48,7 +48,9 @@ class GBufferRaster {
   void render(const EyeCamera eyes[2], bool waitForReaders = false);
   void waitDone();  ///< the host waits for the last render (at most 10 s)
   PrimaryHitsView hostView(Eye eye) const;  ///< host-visible path, after waitDone()
-  double lastGpuMs();  ///< the last render's GPU time (timestamps; waits for it)
+  // The last render's GPU time (timestamps; waits for it); drawMs: of it, the raster passes (the
+  // rest copies the targets into the buffer).
+  double lastGpuMs(double* drawMs = nullptr);
 
   // The shared buffer: [triangle ids of the left eye, of the right eye, barycentrics left, right].
   bool sharedWithCuda() const { return shared_; }

@@ -18,6 +18,8 @@ ProgressiveReference::ProgressiveReference(FrameRenderer& renderer, const Stereo
   options_.stereo = StereoMode::Separate;
   options_.density = DensityScheme::PerPixel;  // an estimate per pixel: no cell's blur in the reference
   options_.primary = PrimaryVisibility::Rays;   // the reference traces every ray it uses
+  options_.gather.overrideEffects = true;      // the whole light transport, whatever the materials' effect levels
+  options_.gather.effects = EffectLevel::Gi;
   options_.foveation.mask = nullptr;
   options_.temporal.enabled = false;
   options_.denoise.enabled = false;

@@ -256,4 +256,13 @@ Vec3 Scene::totalLightPower() const {
   return power;
 }
 
+bool effectLevelFromName(const std::string& name, EffectLevel& level) {
+  for (int i = 0; i < kEffectLevels; ++i)
+    if (name == effectLevelName(EffectLevel(i))) {
+      level = EffectLevel(i);
+      return true;
+    }
+  return false;
+}
+
 }  // namespace pvr

@@ -63,6 +63,7 @@ class Scene {
   uint64_t skippedTriangles() const { return skippedTriangles_; }
   const std::vector<MeshRange>& meshes() const { return meshes_; }
   const std::vector<Material>& materials() const { return materials_; }
+  void setEffect(uint32_t material, EffectLevel level) { materials_.at(material).effect = level; }
   const std::vector<std::string>& materialNames() const { return materialNames_; }
   // Index of the mesh that holds a triangle, or -1.
   int meshOfTriangle(uint32_t prim) const;
@@ -117,5 +118,8 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
 // A JSON scene file (see docs/scene-format.md) or, for any other extension, a mesh file.
 // The result is finalized. Throws pvr::Error with one line naming the problem.
 Scene loadScene(const std::string& pathOrBuiltin);
+
+// "raster" | "shadows" | "reflections" | "gi" | "path"; false for anything else.
+bool effectLevelFromName(const std::string& name, EffectLevel& level);
 
 }  // namespace pvr

@@ -124,7 +124,13 @@ Scene loadJsonScene(const std::string& path) {
   }
   try {
     if (!doc.is_object()) throw Error("the top level must be an object");
-    checkKeys(doc, "the scene file", {"base", "meshes", "lights", "camera"});
+    checkKeys(doc, "the scene file", {"base", "meshes", "lights", "camera", "effects"});
+    auto effectLevel = [](const json& j, const std::string& what) {
+      EffectLevel level;
+      if (!j.is_string() || !effectLevelFromName(j.get<std::string>(), level))
+        throw Error(what + " must be raster, shadows, reflections, gi or path");
+      return level;
+    };
     Scene scene;
     if (doc.contains("base")) {
       if (!doc["base"].is_string()) throw Error("'base' must name a built-in scene");
@@ -137,7 +143,7 @@ Scene loadJsonScene(const std::string& path) {
       for (const json& m : doc["meshes"]) {
         if (!m.is_object() || !m.contains("file") || !m["file"].is_string())
           throw Error("each entry of 'meshes' needs a \"file\"");
-        checkKeys(m, "a mesh entry", {"file", "scale", "rotate_deg", "translate", "emission_scale", "import_lights"});
+        checkKeys(m, "a mesh entry", {"file", "scale", "rotate_deg", "translate", "emission_scale", "import_lights", "effect"});
         ImportOptions opt;
         if (m.contains("import_lights")) {
           if (!m["import_lights"].is_boolean()) throw Error("mesh import_lights must be true or false");
@@ -152,7 +158,12 @@ Scene loadJsonScene(const std::string& path) {
                          Quat::fromAxisAngle({1, 0, 0}, r.x);
         }
         std::filesystem::path file = expandEnvironment(m["file"].get<std::string>());
+        const size_t materialsBefore = scene.materials().size();
         importMeshFile((file.is_absolute() ? file : dir / file).string(), scene, opt);
+        if (m.contains("effect")) {  // every material this file brought
+          const EffectLevel level = effectLevel(m["effect"], "a mesh's \"effect\"");
+          for (size_t i = materialsBefore; i < scene.materials().size(); ++i) scene.setEffect(uint32_t(i), level);
+        }
       }
     }
     if (doc.contains("lights")) {
@@ -210,6 +221,16 @@ Scene loadJsonScene(const std::string& path) {
       }
     }
     if (doc.contains("camera")) applyCamera(doc["camera"], scene.rig);
+    if (doc.contains("effects")) {  // by material name: Ray-VR's material groups
+      if (!doc["effects"].is_object()) throw Error("'effects' must map material names to effect levels");
+      for (const auto& [name, value] : doc["effects"].items()) {
+        const EffectLevel level = effectLevel(value, "the effect of material '" + name + "'");
+        bool found = false;
+        for (size_t i = 0; i < scene.materials().size(); ++i)
+          if (scene.materialNames()[i] == name) scene.setEffect(uint32_t(i), level), found = true;
+        if (!found) throw Error("'effects' names material '" + name + "', which the scene does not have");
+      }
+    }
     scene.finalize();
     return scene;
   } catch (const Error& e) {

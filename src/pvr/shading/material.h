@@ -17,6 +17,21 @@ enum class MaterialType : uint32_t { Diffuse = 0, Mirror = 1, Glass = 2, Microfa
 // or absent; stochastic transparency would be noisier, not more right): docs/scene-format.md.
 enum class AlphaMode : uint32_t { Opaque = 0, Mask = 1, Blend = 2 };
 
+// Ray-VR's per-material effect levels (its section IV-B), extended with photon mapping: how much
+// of the light transport a surface gets, cheapest first. Each level adds to the one before.
+enum class EffectLevel : uint32_t {
+  Raster = 0,       ///< emission and direct light, unshadowed; mirrors and glass shaded by their tint, not followed
+  Shadows = 1,      ///< direct light by shadow rays
+  Reflections = 2,  ///< mirrors, glass and sharp glossy lobes followed, shadowed direct light where they end
+  Gi = 3,           ///< photon-mapped caustics and indirect light (the default: the main paper's shading)
+  Path = 4,         ///< indirect light path traced instead (next-event estimation, Russian roulette)
+};
+constexpr int kEffectLevels = 5;
+PVR_HOST_DEVICE constexpr const char* effectLevelName(EffectLevel level) {
+  return level == EffectLevel::Raster ? "raster" : level == EffectLevel::Shadows ? "shadows"
+         : level == EffectLevel::Reflections ? "reflections" : level == EffectLevel::Gi ? "gi" : "path";
+}
+
 struct Material {
   MaterialType type = MaterialType::Diffuse;
   Vec3 albedo{0.8f, 0.8f, 0.8f};  ///< diffuse albedo, mirror reflectance or glass transmittance tint
@@ -41,6 +56,7 @@ struct Material {
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alpha = 1.0f;             ///< baseColorFactor's alpha
   float alphaCutoff = 0.5f;       ///< MASK: texels with alpha below this are cut out
+  EffectLevel effect = EffectLevel::Gi;  ///< what the eye paths do at this surface (RenderOptions may override it)
 
   // Every texture reference, for validation.
   std::array<const TextureRef*, 8> textureRefs() const {

@@ -19,7 +19,7 @@
 #include "pvr/util/error.h"
 #include "pvr/vk/eye_transfer.h"
 #include "pvr/vk/frame_source.h"
-#include "pvr/vk/vulkan_context.h"
+#include "pvr/vulkan/vulkan_context.h"
 #ifdef PVR_HAVE_CUDA
 #include "pvr/cuda/display_handover.h"
 #endif
@@ -265,6 +265,8 @@ struct ViewerPresenter::Impl {
       if (settings.taa) ImGui::SliderFloat("TAA blend", &settings.taaBlend, 0.02f, 1.0f);
       ImGui::Checkbox("denoise", &settings.denoise);
       ImGui::Checkbox("raster pre-pass", &settings.rasterPrimary);
+      static const char* effectNames[] = {"per material", "raster", "shadows", "reflections", "gi", "path"};
+      ImGui::Combo("effects", &settings.effects, effectNames, 1 + kEffectLevels);
       ImGui::SliderFloat("exposure", &settings.exposure, 0.1f, 8.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
       ImGui::Checkbox("both eyes (Tab)", &settings.bothEyes);
       ImGui::Separator();
@@ -511,6 +513,10 @@ void ViewerPresenter::adjustOptions(RenderOptions& o) {
   if (s.taa != a.taa) o.temporal.enabled = s.taa;
   if (s.taaBlend != a.taaBlend) o.temporal.taa.blend = s.taaBlend;
   if (s.denoise != a.denoise) o.denoise.enabled = s.denoise;
+  if (s.effects != a.effects) {
+    o.gather.overrideEffects = s.effects > 0;
+    o.gather.effects = EffectLevel(std::clamp(s.effects - 1, 0, kEffectLevels - 1));
+  }
   if (s.rasterPrimary != a.rasterPrimary) o.primary = s.rasterPrimary ? PrimaryVisibility::Raster : PrimaryVisibility::Rays;
   if (s.foveated != a.foveated || (s.foveated && s.acuity != a.acuity)) {
     if (s.foveated) {

@@ -28,6 +28,7 @@ struct ViewerSettings {
   float taaBlend = 0.1f;
   bool denoise = false;
   bool rasterPrimary = false;      ///< --primary raster (the G-buffer pre-pass)
+  int effects = 0;                 ///< 0: each material's own level; 1 + EffectLevel: --effects for all
   float exposure = 1.0f;
   int backend = 0;                 ///< 0 cpu, 1 cuda
   bool bothEyes = true;

@@ -12,7 +12,7 @@
 
 #include "pvr/image/display_encoding.h"
 #include "pvr/image/image.h"
-#include "pvr/vk/vulkan_context.h"
+#include "pvr/vulkan/vulkan_context.h"
 
 namespace pvr {
 

@@ -18,7 +18,7 @@
 #include "pvr/util/error.h"
 #include "pvr/vk/eye_transfer.h"
 #include "pvr/vk/frame_source.h"
-#include "pvr/vk/vulkan_context.h"
+#include "pvr/vulkan/vulkan_context.h"
 #include "pvr/xr/xr_views.h"
 #ifdef PVR_HAVE_CUDA
 #include "pvr/cuda/display_handover.h"

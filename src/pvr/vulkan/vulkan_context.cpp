@@ -1,4 +1,4 @@
-#include "pvr/vk/vulkan_context.h"
+#include "pvr/vulkan/vulkan_context.h"
 
 #include <algorithm>
 #include <cstring>
