@@ -4,8 +4,10 @@
 // CPU (Embree) backend and the CUDA backend run the same algorithm code.
 #if defined(__CUDACC__)
 #define PVR_HOST_DEVICE __host__ __device__
+#define PVR_NOINLINE __noinline__  // a rarely taken path kept out of its callers' register budget
 #else
 #define PVR_HOST_DEVICE
+#define PVR_NOINLINE
 #endif
 
 #include <cstdint>
