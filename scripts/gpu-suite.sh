@@ -45,6 +45,10 @@ if [ "${3:-}" != --no-sanitizer ] && command -v compute-sanitizer >/dev/null; th
     part "sanitizer_${tool}_cached" compute-sanitizer --tool "$tool" --error-exitcode 9 \
       "$bundle/photonvr" render cornell-caustics "${small[@]}" --density cache --stereo gather --denoise \
       --trajectory tests/data/gaze_pursuit.traj
+    # The G-buffer pre-pass (Vulkan memory CUDA imported; needs the Vulkan loader) and the path level.
+    part "sanitizer_${tool}_raster" compute-sanitizer --tool "$tool" --error-exitcode 9 \
+      "$bundle/photonvr" render cornell-caustics "${small[@]}" --primary raster --effects path --stereo gather \
+      --trajectory tests/data/gaze_pursuit.traj
   done
 fi
 echo "$failures part(s) failed"

@@ -188,7 +188,9 @@ TEST(EffectLevels, SceneFilesSetThemPerMeshAndPerMaterialName) {
   for (size_t i = 0; i < scene.materials().size(); ++i) {
     const EffectLevel l = scene.materials()[i].effect;
     shadows += l == EffectLevel::Shadows, raster += l == EffectLevel::Raster, gi += l == EffectLevel::Gi;
-    if (scene.materialNames()[i] == "light") EXPECT_EQ(int(l), int(EffectLevel::Raster));
+    if (scene.materialNames()[i] == "light") {
+      EXPECT_EQ(int(l), int(EffectLevel::Raster));
+    }
   }
   EXPECT_GT(shadows, 0u);
   EXPECT_GT(raster, 0u);
