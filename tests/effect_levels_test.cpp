@@ -136,6 +136,39 @@ TEST(EffectLevels, ReflectionsFollowsMirrorsAndGlassAsGiDoes) {
   EXPECT_GT(differsFromShadows, specular / 2) << "below reflections, mirrors and glass are shaded by their tint instead";
 }
 
+// A rough glass panel (a microfacet surface that mostly transmits): below reflections nothing is
+// followed, so every eye path ends on the panel with its light estimated there (none goes black
+// on a follow decision that has no lobe to follow).
+TEST(EffectLevels, BelowReflectionsRoughGlassIsShadedWhereItIsHit) {
+  Scene scene;
+  Material frosted;
+  frosted.type = MaterialType::Microfacet;
+  frosted.transmission = 1.0f;
+  frosted.roughness = 0.6f;
+  frosted.albedo = {0.9f, 0.9f, 0.9f};
+  const uint32_t id = scene.addMaterial(frosted, "frosted");
+  scene.addMesh("panel", {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {}, {0, 1, 2, 0, 2, 3}, id);
+  PunctualLight lamp;
+  lamp.position = {0, 0, 2};
+  scene.addPunctualLight(lamp, "lamp");
+  scene.finalize();
+  CpuBackend backend(scene);
+  for (EffectLevel level : {EffectLevel::Raster, EffectLevel::Shadows}) {
+    int lit = 0;
+    for (int i = 0; i < 400; ++i) {
+      const Vec3 target{-0.8f + 1.6f * float(i % 20) / 19.0f, -0.8f + 1.6f * float(i / 20) / 19.0f, 0.0f};
+      const Vec3 eye{0.1f, 0.2f, 1.0f};
+      CounterRng rng(3, uint32_t(i), 0);
+      const GatherPoint g = traceToGatherPoint(scene.view(), backend.intersector(), atLevel(level), Ray{eye, normalize(target - eye)}, rng);
+      EXPECT_NEAR(g.position.z, 0.0f, 1e-4f) << effectLevelName(level) << " ray " << i << " ends on the panel";
+      EXPECT_GT(length(g.normal), 0.5f);
+      lit += luminance(g.radiance) > 0.0f;
+      EXPECT_LT(luminance(g.radiance), 10.0f) << "no pixel scaled up by a rare choice";
+    }
+    EXPECT_EQ(lit, 400) << effectLevelName(level);
+  }
+}
+
 // The furnace (a closed cube, albedo rho, emission Le everywhere) has radiance Le / (1 - rho):
 // path tracing with next-event estimation must find it without a photon map.
 TEST(EffectLevels, PathConvergesToTheFurnaceRadiance) {

@@ -184,19 +184,21 @@ size_t CudaFrameBackend::buildPhotonMap(PhotonMapKind kind, float radius) {
 void CudaFrameBackend::rasterizePrimary(const EyeCamera eyes[2]) {
   Impl& m = *impl_;
   Impl::Raster& r = m.raster;
-  if (!r.pass) {
+  if (!r.pass) {  // made whole or not at all: a failure leaves nothing half set up
+    Impl::Raster made;
     VulkanContextOptions options;
     options.hasPreferredUuid = cuda::currentDeviceUuid(options.preferredUuid);
     try {
-      r.vulkan = std::make_unique<VulkanContext>(options);
+      made.vulkan = std::make_unique<VulkanContext>(options);
     } catch (const Error& e) {
       throw Error(std::string("--primary raster: ") + e.what());
     }
-    if (!options.hasPreferredUuid || std::memcmp(r.vulkan->deviceUuid(), options.preferredUuid, 16) != 0)
-      throw Error("--primary raster: Vulkan found no device that is the CUDA GPU (it found '" + r.vulkan->deviceName() + "')");
-    r.pass = std::make_unique<GBufferRaster>(*r.vulkan, m.scene, true);
-    r.done = std::make_unique<cuda::SharedSemaphore>(r.pass->exportRasterDoneFd());
-    r.readersDone = std::make_unique<cuda::SharedSemaphore>(r.pass->exportReadersDoneFd());
+    if (!options.hasPreferredUuid || std::memcmp(made.vulkan->deviceUuid(), options.preferredUuid, 16) != 0)
+      throw Error("--primary raster: Vulkan found no device that is the CUDA GPU (it found '" + made.vulkan->deviceName() + "')");
+    made.pass = std::make_unique<GBufferRaster>(*made.vulkan, m.scene, true);
+    made.done = std::make_unique<cuda::SharedSemaphore>(made.pass->exportRasterDoneFd());
+    made.readersDone = std::make_unique<cuda::SharedSemaphore>(made.pass->exportReadersDoneFd());
+    r = std::move(made);
   }
   r.pass->render(eyes, r.readersSignalled);
   r.readersSignalled = false;

@@ -274,7 +274,8 @@ PVR_HOST_DEVICE PVR_NOINLINE Vec3 pathTracedRadiance(const SceneView& scene, con
       throughput *= bs.weight;
       ray.dir = bs.wi;
       ray.origin = sp.position + (dot(bs.wi, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal) * eps;
-      countEmission = false;
+      // The area and sky estimators see the front side only: what a transmitted ray finds, they missed.
+      countEmission = dot(bs.wi, nGeo) < 0.0f;
     } else {
       ray.dir = scatterSpecular(m, ray.dir, sp.shadingNormal, rng.uniform(), throughput);
       ray.origin = sp.position + (dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal) * eps;
@@ -377,7 +378,7 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
           followNothing ? 0u : kLobeTransmission | (b.alpha < kGatheredMinAlpha ? uint32_t(kLobeReflection) : 0u);
       float p[3];
       b.lobeProbabilities(dot(b.normal, wo), kLobesAll, p);
-      const float pFollow = ((followed & kLobeReflection) ? p[1] : 0.0f) + p[2];
+      const float pFollow = ((followed & kLobeReflection) ? p[1] : 0.0f) + ((followed & kLobeTransmission) ? p[2] : 0.0f);
       bool follow = pFollow >= 1.0f;
       if (pFollow > 0.0f && pFollow < 1.0f) follow = rng.uniform() < pFollow;
       if (!follow) {

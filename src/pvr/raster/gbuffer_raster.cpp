@@ -356,8 +356,7 @@ GBufferRaster::~GBufferRaster() = default;
 void GBufferRaster::resize(int width, int height) {
   Impl& s = *impl_;
   s.destroyTargets();
-  width_ = width, height_ = height;
-  ++generation_;
+  width_ = height_ = 0;  // until everything below exists: a failed resize is retried by the next render
   const VkImageUsageFlags colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   s.triangleImage = makeImage(vk_, width, height, kTriangleFormat, colour, 2);
   s.barycentricImage = makeImage(vk_, width, height, kBarycentricFormat, colour, 2);
@@ -378,7 +377,10 @@ void GBufferRaster::resize(int width, int height) {
     vkCheck(vkCreateFramebuffer(s.device, &fci, nullptr, &s.framebuffers[pass]), "vkCreateFramebuffer");
   }
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  s.hits = shared_ ? makeExportableBuffer(vk_, bufferBytes(), usage) : makeHostBuffer(vk_, bufferBytes(), usage);
+  const size_t bytes = size_t(width) * size_t(height) * 2 * (sizeof(uint32_t) + sizeof(Vec2));
+  s.hits = shared_ ? makeExportableBuffer(vk_, bytes, usage) : makeHostBuffer(vk_, bytes, usage);
+  width_ = width, height_ = height;
+  ++generation_;
 }
 
 size_t GBufferRaster::bufferBytes() const {
