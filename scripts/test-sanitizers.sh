@@ -17,5 +17,9 @@ export PVR_REQUIRE_VULKAN=1
 # packaging test, run by test.sh. The viewer's GLX driver (Mesa, loaded and unloaded by GLFW, its
 # frames without symbols) leaks 112 bytes at exit: the viewer runs with leak checks off, the
 # rest of ASan and UBSan on.
-ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -E '^(install_consumer|viewer_xvfb)$'
-ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 ctest --test-dir "$build" --output-on-failure -R '^viewer_xvfb$'
+# Lavapipe leaks the same 112 bytes (two 56-byte callocs in a module it unloads, so no symbol to
+# suppress) once it has compiled a graphics pipeline: the G-buffer pre-pass's tests and the render
+# modes that use it run with leak checks off as well.
+nolsan='^(viewer_xvfb|cli_modes|RasterGBuffer\..*)$'
+ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -E "^(install_consumer)\$|$nolsan"
+ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 ctest --test-dir "$build" --output-on-failure -R "$nolsan"
