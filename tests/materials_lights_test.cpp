@@ -122,23 +122,7 @@ TEST(Textures, RayConeChoosesTheExpectedLevel) {
 // A floor at y = 0, a quad at y = 0.5 whose texture's left half (u < 0.5) is cut out, and a
 // shadow ray from each floor point straight up: blocked exactly where the quad is opaque.
 TEST(Alpha, CutOutTexelsCastNoShadowOnBothIntersectors) {
-  Scene scene;
-  std::vector<uint32_t> texels;
-  for (int y = 0; y < 8; ++y)
-    for (int x = 0; x < 8; ++x) texels.push_back(rgba(200, 200, 200, x < 4 ? 0 : 255));
-  Material cut;
-  cut.baseColorTexture.texture = int32_t(scene.addTexture("mask", 8, 8, texels, true, WrapMode::ClampToEdge, WrapMode::ClampToEdge));
-  cut.alphaMode = AlphaMode::Mask;
-  uint32_t cutId = scene.addMaterial(cut, "cut");
-  uint32_t floorId = scene.addMaterial(Material{}, "floor");
-  std::vector<Vec2> uvs[2] = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {}};
-  scene.addMesh("quad", {{-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}, {-0.5f, 0.5f, 0.5f}}, {}, uvs,
-                {0, 2, 1, 0, 3, 2}, cutId);
-  scene.addMesh("floor", {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}}, {}, {0, 2, 1, 0, 3, 2}, floorId);
-  PunctualLight lamp;
-  lamp.position = {0, 3, 0};
-  scene.addPunctualLight(lamp, "lamp");
-  scene.finalize();
+  Scene scene = test::cutOutQuadOverFloor();
   ASSERT_TRUE(scene.hasAlphaTestedMaterial());
   EmbreeIntersector embree(scene);
   Bvh bvh = Bvh::build(scene);

@@ -17,19 +17,11 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "test_scenes.h"
+#include "vulkan_test_context.h"
 
 namespace pvr {
 namespace {
-
-std::unique_ptr<VulkanContext> contextOrSkip() {
-  try {
-    return std::make_unique<VulkanContext>(VulkanContextOptions());
-  } catch (const Error& e) {
-    const char* require = std::getenv("PVR_REQUIRE_VULKAN");
-    if (require && std::string(require) == "1") ADD_FAILURE() << "no Vulkan device: " << e.what();
-    return nullptr;
-  }
-}
 
 // The default rig (asymmetric per-eye fields of view), small, the head turned and tilted.
 StereoRig smallTurnedRig(const Scene& scene, int width, int height) {
@@ -110,7 +102,7 @@ Registration registerAgainstRays(const Scene& scene, const StereoRig& rig, Vulka
 
 // The pass the context chooses (lavapipe: a pass per eye), a turned head whose view clips walls.
 TEST(RasterGBuffer, FirstHitsAreTheTracedOnesPixelByPixel) {
-  auto vk = contextOrSkip();
+  auto vk = test::vulkanContextOrSkip();
   if (!vk) GTEST_SKIP() << "no Vulkan device on this machine";
   for (const char* name : {"cornell", "cornell-caustics", "cornell-dense"}) {
     SCOPED_TRACE(name);
@@ -130,7 +122,7 @@ TEST(RasterGBuffer, FirstHitsAreTheTracedOnesPixelByPixel) {
 // a view lavapipe's multiview draws right: the head looking into the box, no triangle clipped.
 // The same triangles and barycentrics in every pixel of both eyes.
 TEST(RasterGBuffer, MultiviewAndAPassPerEyeDrawTheSameBuffer) {
-  auto vk = contextOrSkip();
+  auto vk = test::vulkanContextOrSkip();
   if (!vk) GTEST_SKIP() << "no Vulkan device on this machine";
   Scene scene = loadScene("cornell");
   StereoRig rig = scene.rig;
@@ -171,7 +163,7 @@ FrameResult renderOnCpu(const Scene& scene, PrimaryVisibility primary, uint32_t 
 // The pre-pass changes a frame by rounding only: far less than the frame's own noise (another
 // seed), with the same first triangle in nearly every pixel. Separate eyes and gather reuse.
 TEST(RasterGBuffer, FramesFromRasterisedHitsEqualTracedFramesUpToRounding) {
-  auto vk = contextOrSkip();
+  auto vk = test::vulkanContextOrSkip();
   if (!vk) GTEST_SKIP() << "no Vulkan device on this machine";
   vk.reset();
   Scene scene = loadScene("cornell-caustics");
@@ -197,26 +189,10 @@ TEST(RasterGBuffer, FramesFromRasterisedHitsEqualTracedFramesUpToRounding) {
 // A quad whose left half (x < 0) is cut out, over a floor, seen from above: through the cut-out
 // texels the eye sees the floor, with the pre-pass as with rays (those pixels are traced).
 TEST(RasterGBuffer, CutOutTexelsAreSeenThroughAsByRays) {
-  auto vk = contextOrSkip();
+  auto vk = test::vulkanContextOrSkip();
   if (!vk) GTEST_SKIP() << "no Vulkan device on this machine";
   vk.reset();
-  Scene scene;
-  std::vector<uint32_t> texels;
-  for (int y = 0; y < 8; ++y)
-    for (int x = 0; x < 8; ++x) texels.push_back(x < 4 ? 0x00c8c8c8u : 0xffc8c8c8u);  // RGBA, alpha in the top byte
-  Material cut;
-  cut.baseColorTexture.texture = int32_t(scene.addTexture("mask", 8, 8, texels, true, WrapMode::ClampToEdge, WrapMode::ClampToEdge));
-  cut.alphaMode = AlphaMode::Mask;
-  const uint32_t cutId = scene.addMaterial(cut, "cut");
-  const uint32_t floorId = scene.addMaterial(Material{}, "floor");
-  std::vector<Vec2> uvs[2] = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {}};
-  scene.addMesh("quad", {{-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}, {-0.5f, 0.5f, 0.5f}}, {}, uvs,
-                {0, 2, 1, 0, 3, 2}, cutId);
-  scene.addMesh("floor", {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}}, {}, {0, 2, 1, 0, 3, 2}, floorId);
-  PunctualLight lamp;
-  lamp.position = {0, 3, 0};
-  scene.addPunctualLight(lamp, "lamp");
-  scene.finalize();
+  Scene scene = test::cutOutQuadOverFloor();
   scene.rig.head.position = {0, 2, 0};
   scene.rig.head.orientation = Quat::fromAxisAngle({1, 0, 0}, -0.5f * kPi);  // looking down
   auto render = [&](PrimaryVisibility primary) {

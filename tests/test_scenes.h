@@ -48,4 +48,28 @@ inline Scene furnaceBox(float rho, float le) {
   return scene;
 }
 
+// A floor at y = 0 (4x4 m) under a point light at (0, 3, 0), and a quad at y = 0.5 over x, z in
+// [-0.5, 0.5] whose texture's left half (u < 0.5, x < 0) is cut out (alpha MASK): triangles 0-1
+// are the quad, 2-3 the floor.
+inline Scene cutOutQuadOverFloor() {
+  Scene scene;
+  std::vector<uint32_t> texels;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) texels.push_back(200u | 200u << 8 | 200u << 16 | uint32_t(x < 4 ? 0 : 255) << 24);
+  Material cut;
+  cut.baseColorTexture.texture = int32_t(scene.addTexture("mask", 8, 8, texels, true, WrapMode::ClampToEdge, WrapMode::ClampToEdge));
+  cut.alphaMode = AlphaMode::Mask;
+  const uint32_t cutId = scene.addMaterial(cut, "cut");
+  const uint32_t floorId = scene.addMaterial(Material{}, "floor");
+  std::vector<Vec2> uvs[2] = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {}};
+  scene.addMesh("quad", {{-0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}, {-0.5f, 0.5f, 0.5f}}, {}, uvs,
+                {0, 2, 1, 0, 3, 2}, cutId);
+  scene.addMesh("floor", {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}}, {}, {0, 2, 1, 0, 3, 2}, floorId);
+  PunctualLight lamp;
+  lamp.position = {0, 3, 0};
+  scene.addPunctualLight(lamp, "lamp");
+  scene.finalize();
+  return scene;
+}
+
 }  // namespace pvr::test

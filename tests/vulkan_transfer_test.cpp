@@ -11,20 +11,11 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "vulkan_test_context.h"
 #include "pvr/vk/eye_transfer.h"
 
 namespace pvr {
 namespace {
-
-std::unique_ptr<VulkanContext> makeContextOrSkip() {
-  try {
-    return std::make_unique<VulkanContext>(VulkanContextOptions());
-  } catch (const Error& e) {
-    const char* require = std::getenv("PVR_REQUIRE_VULKAN");
-    if (require && std::string(require) == "1") ADD_FAILURE() << "no Vulkan device: " << e.what();
-    return nullptr;
-  }
-}
 
 struct Rendered {
   FrameResult frame;
@@ -52,7 +43,7 @@ std::vector<unsigned char> expectedBytes(const Image& image, DisplayEncoding enc
 }
 
 void roundTrip(VkFormat format, DisplayEncoding encoding) {
-  auto vk = makeContextOrSkip();
+  auto vk = test::vulkanContextOrSkip();
   if (!vk) GTEST_SKIP() << "no Vulkan device on this machine";
   const Rendered& r = cornell();
   EyeTransferOptions o;
