@@ -92,13 +92,7 @@ struct CudaFrameBackend::Impl {
   }
 
   PrimaryHitsView primaryHits(Eye eye) const {
-    PrimaryHitsView v;
-    const size_t pixels = size_t(raster.pass->width()) * size_t(raster.pass->height());
-    auto* bytes = static_cast<const unsigned char*>(raster.buffer->data());
-    v.prim = reinterpret_cast<const uint32_t*>(bytes) + pixels * size_t(eye);
-    v.barycentrics = reinterpret_cast<const Vec2*>(bytes + 2 * pixels * sizeof(uint32_t)) + pixels * size_t(eye);
-    v.width = raster.pass->width();
-    return v;
+    return gbufferEyeView(raster.buffer->data(), raster.pass->width(), raster.pass->height(), eye);
   }
 
   cuda::DeviceMap map() {

@@ -101,6 +101,20 @@ void rasterWorldToClip(const EyeCamera& camera, float nearDepth, float out[16]) 
     for (int row = 0; row < 4; ++row) out[col * 4 + row] = float(m[row][col]);
 }
 
+size_t gbufferBytes(int width, int height) {
+  return size_t(width) * size_t(height) * 2 * (sizeof(uint32_t) + sizeof(Vec2));
+}
+
+PrimaryHitsView gbufferEyeView(const void* base, int width, int height, Eye eye) {
+  const size_t pixels = size_t(width) * size_t(height);
+  const auto* bytes = static_cast<const unsigned char*>(base);
+  PrimaryHitsView v;
+  v.prim = reinterpret_cast<const uint32_t*>(bytes) + pixels * size_t(eye);
+  v.barycentrics = reinterpret_cast<const Vec2*>(bytes + 2 * pixels * sizeof(uint32_t)) + pixels * size_t(eye);
+  v.width = width;
+  return v;
+}
+
 struct GBufferRaster::Impl {
   VkDevice device = VK_NULL_HANDLE;
   VkCommandPool commandPool = VK_NULL_HANDLE;
@@ -377,14 +391,14 @@ void GBufferRaster::resize(int width, int height) {
     vkCheck(vkCreateFramebuffer(s.device, &fci, nullptr, &s.framebuffers[pass]), "vkCreateFramebuffer");
   }
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  const size_t bytes = size_t(width) * size_t(height) * 2 * (sizeof(uint32_t) + sizeof(Vec2));
+  const size_t bytes = gbufferBytes(width, height);
   s.hits = shared_ ? makeExportableBuffer(vk_, bytes, usage) : makeHostBuffer(vk_, bytes, usage);
   width_ = width, height_ = height;
   ++generation_;
 }
 
 size_t GBufferRaster::bufferBytes() const {
-  return size_t(width_) * size_t(height_) * 2 * (sizeof(uint32_t) + sizeof(Vec2));
+  return gbufferBytes(width_, height_);
 }
 
 size_t GBufferRaster::bufferAllocationBytes() const { return size_t(impl_->hits.allocationSize); }
@@ -478,14 +492,8 @@ void GBufferRaster::render(const EyeCamera eyes[2], bool waitForReaders) {
 }
 
 PrimaryHitsView GBufferRaster::hostView(Eye eye) const {
-  PrimaryHitsView v;
-  if (shared_ || !impl_->hits.mapped) return v;
-  const size_t pixels = size_t(width_) * size_t(height_);
-  const auto* bytes = static_cast<const unsigned char*>(impl_->hits.mapped);
-  v.prim = reinterpret_cast<const uint32_t*>(bytes) + pixels * size_t(eye);
-  v.barycentrics = reinterpret_cast<const Vec2*>(bytes + 2 * pixels * sizeof(uint32_t)) + pixels * size_t(eye);
-  v.width = width_;
-  return v;
+  if (shared_ || !impl_->hits.mapped) return PrimaryHitsView();
+  return gbufferEyeView(impl_->hits.mapped, width_, height_, eye);
 }
 
 double GBufferRaster::lastGpuMs(double* drawMs) {

@@ -32,6 +32,11 @@ void rasterWorldToClip(const EyeCamera& camera, float nearDepth, float out[16]);
 // head's left eye showed the right eye's walls; each view alone is exact).
 enum class GBufferViews : int { Auto = 0, Multiview = 1, PassPerView = 2 };
 
+// The buffer's layout: [triangle ids of the left eye, of the right eye, barycentrics left, right].
+size_t gbufferBytes(int width, int height);
+// One eye's view into such a buffer at `base` (host or device memory).
+PrimaryHitsView gbufferEyeView(const void* base, int width, int height, Eye eye);
+
 class GBufferRaster {
  public:
   // Uploads the scene's triangles. shareWithCuda: the buffer and the semaphores are exportable
@@ -52,7 +57,7 @@ class GBufferRaster {
   // rest copies the targets into the buffer).
   double lastGpuMs(double* drawMs = nullptr);
 
-  // The shared buffer: [triangle ids of the left eye, of the right eye, barycentrics left, right].
+  // The shared buffer (laid out as gbufferEyeView reads it).
   bool sharedWithCuda() const { return shared_; }
   int width() const { return width_; }
   int height() const { return height_; }
