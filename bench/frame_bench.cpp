@@ -18,6 +18,8 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "bench_util.h"
+#include "controller_bench.h"
+#include "effects_bench.h"
 #include "quality_bench.h"
 #include "pvr/util/latency_stats.h"
 #include "pvr/util/error.h"
@@ -944,8 +946,10 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
 
 int runFrameBench(const FrameBenchArgs& args) {
   if (args.suite != "tables" && args.suite != "rays" && args.suite != "grid" && args.suite != "stereo" &&
-      args.suite != "foveation" && args.suite != "scenes" && args.suite != "quality" && args.suite != "all")
-    throw Error("--suite must be tables, stereo, foveation, scenes, quality, rays, grid or all, got '" + args.suite + "'");
+      args.suite != "foveation" && args.suite != "scenes" && args.suite != "quality" && args.suite != "effects" &&
+      args.suite != "controller" && args.suite != "all")
+    throw Error("--suite must be tables, stereo, foveation, scenes, quality, effects, controller, rays, grid or all, got '" + args.suite + "'");
+  if (!args.profileOut.empty() && args.suite != "effects") throw Error("--profile-out is for --suite effects");
   if (!(args.sceneRadius > 0.0f) || !std::isfinite(args.sceneRadius)) throw Error("--scene-radius must be a positive number");
   if (args.frames < 1 || args.frames > 100000) throw Error("--frames must be between 1 and 100000");
   if (args.warmup < 0 || args.warmup > 100000) throw Error("--warmup must be between 0 and 100000");
@@ -968,6 +972,8 @@ int runFrameBench(const FrameBenchArgs& args) {
   }
   if (args.suite == "scenes") failures += runScenes(args, kind, json);
   if (args.suite == "quality") failures += runQuality(args, kind, json);
+  if (args.suite == "effects") failures += runEffects(args, kind, json);
+  if (args.suite == "controller") failures += runControllerBench(args, kind, json);
 #ifdef PVR_HAVE_CUDA
   if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json);
   if (args.suite == "grid" || args.suite == "all") failures += runGrid(args, json);

@@ -10,7 +10,8 @@
 //  - foveation: foveated against full-resolution frames, and the temporal flicker with and without TAA;
 //  - scenes: textured scenes (Dabrovic Sponza, Sibenik) with full shading: separate and gather
 //    frames, the cost of texture sampling, and each image's error against a converged reference;
-//  - quality: raw, TAA and denoised frames against converged references (quality_bench.h).
+//  - quality: raw, TAA and denoised frames against converged references (quality_bench.h);
+//  - effects: Ray-VR's experiments, mono / stereo, rays / raster pre-pass, effect levels (effects_bench.h).
 // Every suite checks its own results and says which GPU, resolution, photons and radius it ran.
 // Timings are tail latencies (one slow frame drops a frame in the headset): every frame cell keeps
 // each timed frame's wall time and stage times and reports their mean, p50, p99 and max
@@ -33,6 +34,12 @@ struct FrameBenchArgs {
   int referencePasses = 64;   ///< tables, scenes and quality suites: passes of the progressive reference (1024x1024 photons each)
   std::string qualityScenes = "cornell,scenes/dabrovic-sponza.json";  ///< quality suite
   std::string qualityImages;  ///< quality suite: PNG prefix (empty: none)
+  std::string effectsScenes = "cornell-caustics,cornell-dense,scenes/dabrovic-sponza.json,scenes/sibenik.json";  ///< effects suite
+  std::string profileOut;     ///< effects suite: the controller's calibrated profiles, PREFIX_<scene>.json (empty: none)
+  std::string walks;          ///< controller suite: SCENE=TRAJECTORY,...
+  std::string budgets = "11.1,5.5";  ///< controller suite: frame budgets, ms
+  std::string profiles;       ///< controller suite: read PREFIX_<scene>.json where it exists (else the generic model)
+  int errorEvery = 45;        ///< controller suite: a reference view every this many frames
   int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)
   int warmup = 10;
   int k = 32;

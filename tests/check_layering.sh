@@ -25,11 +25,12 @@ declare -A allowed=(
   [cuda]="raster vulkan pipeline accel photon stereo foveation denoise temporal image scene shading camera geometry math util"
   [reference]="pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
   [render]="raster vulkan cpu cuda pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
-  [loop]="render raster vulkan pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
+  [control]="pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
+  [loop]="control render raster vulkan pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
   [vk]="vulkan loop cuda image geometry math util"
-  [xr]="vulkan raster loop vk render cuda pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
-  [viewer]="vulkan raster loop vk render cuda pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
-  [app]="viewer xr vk vulkan raster loop render reference cpu cuda pipeline accel photon stereo foveation denoise temporal image scene shading camera geometry math util"
+  [xr]="control vulkan raster loop vk render cuda pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
+  [viewer]="control vulkan raster loop vk render cuda pipeline photon stereo foveation denoise temporal image scene shading camera geometry math util"
+  [app]="control viewer xr vk vulkan raster loop render reference cpu cuda pipeline accel photon stereo foveation denoise temporal image scene shading camera geometry math util"
 )
 failures=0
 for dir in "$src"/*/; do

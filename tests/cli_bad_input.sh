@@ -81,6 +81,22 @@ expect_error "--primary must be rays or raster" render cornell --backend cpu --p
 # The pre-pass without any Vulkan driver (the loader finds none): one line, before any frame.
 VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json \
   expect_error "--primary raster: no Vulkan driver found" render cornell --backend cpu --primary raster "${small[@]}"
+# Effect groups and the budget controller.
+expect_error "no effect group 'statues' (it has: rest, specular)" render cornell-caustics --backend cpu --effects statues=gi "${small[@]}"
+expect_error "is not GROUP=LEVEL" render cornell-caustics --backend cpu --effects specular=shiny "${small[@]}"
+expect_error "is not GROUP=LEVEL" render cornell-caustics --backend cpu --effects specular=gi,rest "${small[@]}"
+expect_error "--budget-ms is for --trajectory" render cornell --backend cpu --budget-ms 11.1 "${small[@]}"
+printf '0 0.5 1  0 0 0 1  0.5 0.5\n' >"$out/one.traj"
+expect_error "--budget-ms must be a positive number" render cornell --backend cpu --budget-ms -2 --trajectory "$out/one.traj" "${small[@]}"
+expect_error "--budget-ms must be a positive number" render cornell --backend cpu --budget-ms nan --trajectory "$out/one.traj" "${small[@]}"
+expect_error "cannot open controller profile" render cornell --backend cpu --budget-ms 11.1 --controller-profile "$out/none.json" \
+  --trajectory "$out/one.traj" "${small[@]}"
+echo '{"error": {"top": 0.1}}' >"$out/short_profile.json"
+expect_error "controller profile '$out/short_profile.json'" render cornell --backend cpu --budget-ms 11.1 \
+  --controller-profile "$out/short_profile.json" --trajectory "$out/one.traj" "${small[@]}"
+expect_error "--profile-out is for --suite effects" bench --suite tables --profile-out "$out/p"
+expect_error "--walks must name SCENE=TRAJECTORY" bench --suite controller --backend cpu
+expect_error "--budgets must be" bench --suite controller --backend cpu --walks "cornell=$out/one.traj" --budgets 5,x
 expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty
 expect_error "--reference-passes must be between 2" bench --suite quality --reference-passes 1 --backend cpu
 expect_error "--suite must be" bench --suite speed

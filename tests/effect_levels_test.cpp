@@ -245,5 +245,72 @@ TEST(EffectLevels, SceneFilesSetThemPerMeshAndPerMaterialName) {
   std::filesystem::remove_all(dir);
 }
 
+// An effect group's level (GatherParams::groupEffects, what --effects GROUP=LEVEL and the budget
+// controller set) is the level its materials would have of their own: same gather points, ray for
+// ray, as a scene whose mirror and glass carry that level.
+TEST(EffectLevels, AGroupsLevelIsItsMaterialsOwn) {
+  const Scene grouped = loadScene("cornell-caustics");
+  const int specular = grouped.effectGroupIndex("specular");
+  ASSERT_GT(specular, 0);
+  EXPECT_EQ(grouped.effectGroupNames()[0], "rest");
+  Scene own = grouped;
+  for (const char* name : {"mirror", "glass"}) own.setEffect(uint32_t(own.materialIndex(name)), EffectLevel::Raster);
+  CpuBackend groupedBackend(grouped), ownBackend(own);
+  GatherParams byGroup;
+  byGroup.groupEffects[specular] = uint8_t(EffectLevel::Raster);
+  const GatherParams byMaterial;
+  StereoRig rig = grouped.rig;
+  rig.width = 40, rig.height = 45;
+  const EyeCamera cam = rig.eye(Eye::Left);
+  size_t differFromGi = 0;
+  for (int y = 0; y < rig.height; ++y)
+    for (int x = 0; x < rig.width; ++x) {
+      const Ray ray = cam.generateRay(x + 0.5f, y + 0.5f);
+      CounterRng a(3, uint32_t(y * rig.width + x), 0), b = a, c = a;
+      const GatherPoint g = traceToGatherPoint(grouped.view(), groupedBackend.intersector(), byGroup, ray, a);
+      const GatherPoint m = traceToGatherPoint(own.view(), ownBackend.intersector(), byMaterial, ray, b);
+      const GatherPoint gi = traceToGatherPoint(grouped.view(), groupedBackend.intersector(), GatherParams(), ray, c);
+      ASSERT_EQ(g.radiance, m.radiance) << x << "," << y;
+      ASSERT_EQ(g.needsEstimate(), m.needsEstimate());
+      differFromGi += !(g.radiance == gi.radiance);
+    }
+  EXPECT_GT(differFromGi, 25u) << "the spheres' pixels change with their group's level";
+  // The override wins over a group's level.
+  GatherParams both = byGroup;
+  both.overrideEffects = true;
+  both.effects = EffectLevel::Gi;
+  EXPECT_EQ(int(effectLevelOf(both, grouped.materials()[size_t(grouped.materialIndex("mirror"))])), int(EffectLevel::Gi));
+  EXPECT_EQ(int(effectLevelOf(byGroup, grouped.materials()[size_t(grouped.materialIndex("mirror"))])), int(EffectLevel::Raster));
+  EXPECT_EQ(int(effectLevelOf(byGroup, grouped.materials()[size_t(grouped.materialIndex("white"))])), int(EffectLevel::Gi));
+}
+
+// "effect_groups" in a scene file: materials by name into named groups; errors name the problem.
+TEST(EffectLevels, SceneFilesNameEffectGroups) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "pvr_effect_groups_test";
+  std::filesystem::create_directories(dir);
+  auto write = [&](const char* name, const std::string& groups) {
+    std::ofstream(dir / name) << R"({"base": "cornell", "effect_groups": )" + groups + "}";
+    return (dir / name).string();
+  };
+  const Scene scene = loadScene(write("good.json", R"({"colour": ["red", "green"], "lamp": ["light"]})"));
+  ASSERT_EQ(scene.effectGroupNames().size(), 3u);
+  const int colour = scene.effectGroupIndex("colour"), lamp = scene.effectGroupIndex("lamp");
+  EXPECT_EQ(scene.materials()[size_t(scene.materialIndex("red"))].effectGroup, uint32_t(colour));
+  EXPECT_EQ(scene.materials()[size_t(scene.materialIndex("green"))].effectGroup, uint32_t(colour));
+  EXPECT_EQ(scene.materials()[size_t(scene.materialIndex("light"))].effectGroup, uint32_t(lamp));
+  EXPECT_EQ(scene.materials()[size_t(scene.materialIndex("white"))].effectGroup, 0u);
+  expectSceneError(write("unknown.json", R"({"statues": ["marble"]})"), "'marble'");
+  expectSceneError(write("twice.json", R"({"a": ["red"], "b": ["red"]})"), "two effect groups");
+  expectSceneError(write("rest.json", R"({"rest": ["red"]})"), "reserved");
+  expectSceneError(write("empty.json", R"({"a": []})"), "must list material names");
+  expectSceneError(write("list.json", R"(["red"])"), "'effect_groups' must map");
+  Scene many = loadScene("cornell");
+  for (int g = 1; g < kMaxEffectGroups; ++g) many.addEffectGroup("g" + std::to_string(g));
+  EXPECT_THROW(many.addEffectGroup("one too many"), Error);
+  EXPECT_THROW(many.addEffectGroup("g1"), Error);
+  EXPECT_THROW(many.setEffectGroup(0, kMaxEffectGroups), Error);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace pvr

@@ -666,5 +666,28 @@ TEST(GpuBackend, EffectLevelsMatchTheCpu) {
     }
 }
 
+// Effect groups' levels (what --effects GROUP=LEVEL and the budget controller set) on the GPU.
+TEST(GpuBackend, EffectGroupLevelsMatchTheCpu) {
+  PVR_REQUIRE_GPU();
+  const Scene scene = builtinScene("cornell-caustics");
+  const int specular = scene.effectGroupIndex("specular");
+  ASSERT_GT(specular, 0);
+  StereoRig rig = scene.rig;
+  rig.width = 160, rig.height = 176;
+  FrameRenderer cpu(makeCpuFrameRenderer(scene)), gpu(makeCudaFrameRenderer(scene));
+  for (auto [rest, spheres] : {std::pair{EffectLevel::Shadows, EffectLevel::Reflections},
+                               std::pair{EffectLevel::Gi, EffectLevel::Raster}, std::pair{EffectLevel::Raster, EffectLevel::Gi}}) {
+    RenderOptions o = comparisonOptions();
+    o.gather.groupEffects[0] = uint8_t(rest);
+    o.gather.groupEffects[specular] = uint8_t(spheres);
+    FrameResult a = cpu.render(rig, o), b = gpu.render(rig, o);
+    ImageCheck c = compare(a, b);
+    const std::string what = std::string("rest ") + effectLevelName(rest) + ", specular " + effectLevelName(spheres);
+    EXPECT_LT(c.relativeMad, 0.01) << what;
+    EXPECT_LT(c.outliers, 0.005) << what;
+    EXPECT_GT(c.firstPrimAgree, 0.995) << what;
+  }
+}
+
 }  // namespace
 }  // namespace pvr

@@ -12,6 +12,7 @@
 #include <csignal>
 #include <fstream>
 #include <optional>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -103,7 +104,18 @@ struct RenderArgs {
   std::string acuity = "linear";  // the mask made at start under --foveated
   std::string settings;           // JSON settings file (the viewer writes them)
   std::optional<Pose> head;       // from the settings file
+  double budgetMs = 0;            // > 0: the budget controller holds each frame under it
+  std::string controllerProfile;  // its calibrated profile (empty: the generic model)
 };
+
+void addBudgetOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_option("--budget-ms", a.budgetMs,
+                 "Frame budget in ms (11.1 at 90 Hz): the controller chooses photons, radius, foveation, denoiser and "
+                 "each effect group's level per frame to keep the p99 frame time under it (docs/ray-vr.md)");
+  cmd.add_option("--controller-profile", a.controllerProfile,
+                 "The controller's calibrated cost and quality model (from `bench --suite effects --profile-out`; "
+                 "default: a generic model)");
+}
 
 // The settings file: the command line's options by name ("radius": "0.05"), the head pose and the
 // gaze. Options given on the command line win over the file's.
@@ -198,7 +210,8 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--effects", a.effects,
                  "Ray-VR's effect level for every material, overriding the scene's: raster (direct light, no shadows) | "
                  "shadows | reflections (mirrors, glass, glossy followed) | gi (photon-mapped, the default) | path "
-                 "(indirect light path traced)");
+                 "(indirect light path traced); or per effect group of the scene, GROUP=LEVEL,... (e.g. "
+                 "floor=reflections,rest=shadows; \"rest\": the materials in no group)");
   cmd.add_option("--backend", a.backend, "cpu (Embree + TBB reference) | cuda | auto (cuda if a GPU is present)")
       ->capture_default_str();
   cmd.add_option("--stereo", a.stereo,
@@ -276,9 +289,9 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   if (a.primary == "rays") o.primary = PrimaryVisibility::Rays;
   else if (a.primary == "raster") o.primary = PrimaryVisibility::Raster;
   else throw Error("--primary must be rays or raster, got '" + a.primary + "'");
-  if (!a.effects.empty()) {
+  if (!a.effects.empty() && a.effects.find('=') == std::string::npos) {  // GROUP=LEVEL lists: setUpRender, with the scene
     if (!effectLevelFromName(a.effects, o.gather.effects))
-      throw Error("--effects must be raster, shadows, reflections, gi or path, got '" + a.effects + "'");
+      throw Error("--effects must be raster, shadows, reflections, gi or path, or GROUP=LEVEL,..., got '" + a.effects + "'");
     o.gather.overrideEffects = true;
   }
   o.stereo = parseStereoMode(a.stereo);
@@ -302,6 +315,24 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   return o;
 }
 
+// --effects GROUP=LEVEL,...: the levels of the scene's effect groups ("rest": the materials in none).
+void setGroupEffects(const std::string& spec, const Scene& scene, GatherParams& gather) {
+  std::stringstream items(spec);
+  for (std::string item; std::getline(items, item, ',');) {
+    const size_t eq = item.find('=');
+    EffectLevel level;
+    if (eq == std::string::npos || !effectLevelFromName(item.substr(eq + 1), level))
+      throw Error("--effects: '" + item + "' is not GROUP=LEVEL (levels: raster, shadows, reflections, gi, path)");
+    const int group = scene.effectGroupIndex(item.substr(0, eq));
+    if (group < 0) {
+      std::string names;
+      for (const std::string& n : scene.effectGroupNames()) names += (names.empty() ? "" : ", ") + n;
+      throw Error("--effects: the scene has no effect group '" + item.substr(0, eq) + "' (it has: " + names + ")");
+    }
+    gather.groupEffects[group] = uint8_t(level);
+  }
+}
+
 // What every command that renders needs, made from the options: the scene, the rig, the
 // validated options and the foveation mask they point at.
 struct RenderSetup {
@@ -323,6 +354,7 @@ std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
   if (a.head) rig.head = *a.head;
   RenderOptions& options = setup->options;
   options = toOptions(a, rig);
+  if (a.effects.find('=') != std::string::npos) setGroupEffects(a.effects, scene, options.gather);
   const std::vector<std::string> builtins = builtinSceneNames();
   if (a.radius.empty() && std::find(builtins.begin(), builtins.end(), a.scene) == builtins.end()) {
     Bounds3 b = scene.bounds();  // a scene of any size: the radius follows it
@@ -385,13 +417,31 @@ int runRender(const RenderArgs& a) {
   std::printf("backend %s: %s%s\n", renderer->name().c_str(), renderer->deviceName().c_str(),
               renderer->name() == "cuda" ? (", " + std::string(densityKernelName(options.kernel)) + " kernel").c_str() : "");
   const char* names[2] = {"left", "right"};
+  if (a.budgetMs != 0 && trajectory.empty()) throw Error("--budget-ms is for --trajectory (and xr, view)");
   if (!trajectory.empty()) {  // one frame per pose, PREFIX_NNNN_left/right
     double totalMs = 0;
+    std::optional<FoveationMask> controlMask;
+    std::unique_ptr<BudgetController> controller =
+        a.budgetMs != 0 ? makeBudgetController(a.budgetMs, a.controllerProfile, scene, options, rig, a.acuity, controlMask)
+                       : nullptr;
+    ControlLog control;
+    const auto start = std::chrono::steady_clock::now();
     for (size_t f = 0; f < trajectory.size(); ++f) {
       rig.head = trajectory[f].head;
+      std::optional<ControlDecision> decision;
+      if (controller) {
+        decision = controller->decide(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        options = controller->optionsFor(decision->setting);
+      }
       std::copy(&trajectory[f].gaze[0][0], &trajectory[f].gaze[0][0] + 4, &options.foveation.gaze[0][0]);
       options.foveation.verge = trajectory[f].verge;
+      const auto frameStart = std::chrono::steady_clock::now();
       FrameResult frame = renderer->render(rig, options);
+      if (controller) {  // the frame's time: the pipeline's, images read back
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frameStart).count();
+        controller->observe(ControlCosts::of(frame.timings, ms));
+        control.add(*decision, ms, ControlCosts::of(frame.timings, ms));
+      }
       totalMs += frame.timings.totalMs();
       char prefix[32];
       std::snprintf(prefix, sizeof prefix, "_%04zu", f);
@@ -409,6 +459,11 @@ int runRender(const RenderArgs& a) {
     }
     std::printf("%zu frames, %.2f ms per frame on average; wrote %s_NNNN_left/right.png/.exr\n", trajectory.size(),
                 totalMs / double(trajectory.size()), a.out.c_str());
+    if (controller) {
+      std::printf("%s", control.summary(*controller).c_str());
+      writeJson(a.out + "_control.json", control.toJson(*controller));
+      std::printf("wrote %s_control.json (each frame's decision and time)\n", a.out.c_str());
+    }
     return 0;
   }
   FrameResult frame = renderer->render(rig, options);
@@ -613,6 +668,7 @@ int runCli(int argc, char** argv) {
       "point, spot and directional lights (KHR_lights_punctual) and a sky (JSON scenes).\n"
       "Defaults render the Cornell box at 1440x1600 per eye with 256x256 photons in a few seconds on 2 cores.");
   addImageCommandOptions(*render, ra, "Samples per pixel");
+  addBudgetOptions(*render, ra);
   render->add_flag("--foveated", ra.foveated,
                    "Foveated: shade only a foveation mask's vertices around the gaze and reconstruct");
   render->add_option("--mask", ra.mask, "Foveation mask file from `photonvr mask` (default: made for the rig at start)");
@@ -668,6 +724,7 @@ int runCli(int argc, char** argv) {
   for (auto [cmd, a] : {std::pair{xr, &xa}, std::pair{view, &va}}) {
     cmd->add_option("scene", a->scene, "Built-in scene name or scene/mesh file")->capture_default_str();
     addRenderOptions(*cmd, *a);
+    addBudgetOptions(*cmd, *a);
     cmd->add_option("--eye-size", a->eyeSize, cmd == xr ? "Per-eye size WxH (default: the runtime's recommended size)"
                                                         : "Per-eye size WxH (default: 640x712)");
     cmd->add_option("--ipd", a->ipd, "Interpupillary distance in metres (view, --offscreen; a headset reports its own)");
@@ -717,7 +774,9 @@ int runCli(int argc, char** argv) {
   bench->add_option("scene", ba.scene, "Scene for the tables, grid and maps suites")->capture_default_str();
   bench->add_option("--suite", fa.suite,
                     "tables | rays | grid | stereo | foveation | scenes (textured scenes, full shading) | quality (raw, "
-                    "TAA and denoised frames against converged references, moving and still head) | all (tables, "
+                    "TAA and denoised frames against converged references, moving and still head) | effects (Ray-VR's "
+                    "experiments: mono / stereo, rays / raster pre-pass, effect levels on all and on groups) | controller (the "
+                    "budget controller on walks, against fixed settings) | all (tables, "
                     "stereo, rays, grid) | maps (CPU map queries)")
       ->capture_default_str();
   bench->add_option("--stereo", fa.stereo, "Table 5's columns: separate, scatter, gather (stereo suite)")
@@ -742,6 +801,15 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   bench->add_option("--quality-images", fa.qualityImages,
                     "Quality suite: write PNGs (the left eye's central 480x480) of a sampled frame of each variant and its reference to PREFIX_*.png");
+  bench->add_option("--effects-scenes", fa.effectsScenes, "Scenes of the effects suite (absent meshes are skipped)")
+      ->capture_default_str();
+  bench->add_option("--profile-out", fa.profileOut,
+                    "Effects suite: calibrate the budget controller on each scene, writing PREFIX_<scene>.json");
+  bench->add_option("--walks", fa.walks, "Controller suite: SCENE=TRAJECTORY,... (scripts/walk_trajectory.py makes walks)");
+  bench->add_option("--budgets", fa.budgets, "Controller suite: frame budgets in ms")->capture_default_str();
+  bench->add_option("--profiles", fa.profiles, "Controller suite: use PREFIX_<scene>.json (from --profile-out) where it exists");
+  bench->add_option("--error-every", fa.errorEvery, "Controller suite: a converged reference of every Nth frame's view")
+      ->capture_default_str();
   bench->add_option("--photons", ba.photons, "Comma-separated photon grids (maps suite)")->capture_default_str();
   bench->add_option("--radii", ba.radii, "Comma-separated search radii (maps suite)")->capture_default_str();
   bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye (maps suite)")
@@ -785,6 +853,8 @@ int runCli(int argc, char** argv) {
       l->exposure = a->exposure;
       l->sceneName = a->scene;
       l->acuity = a->acuity;
+      l->budgetMs = a->budgetMs;
+      l->controllerProfile = a->controllerProfile;
       if (l->cudaCopy != "buffer" && l->cudaCopy != "image") throw Error("--cuda-copy must be buffer or image, got '" + l->cudaCopy + "'");
       if (!(l->nearZ > 0.0f) || !std::isfinite(l->nearZ)) throw Error("--near must be a positive number of metres");
       if (!(l->readyTimeout > 0.0) || !std::isfinite(l->readyTimeout)) throw Error("--ready-timeout must be a positive number of seconds");

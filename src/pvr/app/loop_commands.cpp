@@ -46,15 +46,6 @@ std::vector<ScriptedView> scriptedPath(const std::vector<TrajectoryFrame>& traje
   return path;
 }
 
-void writeJson(const std::string& path, const nlohmann::json& j) {
-  std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  std::error_code error;
-  if (!parent.empty()) std::filesystem::create_directories(parent, error);
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write '" + path + "'");
-  out << j.dump(2) << "\n";
-}
-
 nlohmann::json describeRun(const Renderer& renderer, const LoopSetup& setup, const RenderOptions& o) {
   return {{"backend", renderer.backendName()},
           {"device", renderer.deviceName()},
@@ -85,6 +76,36 @@ void refitMask(RenderOptions& options, const StereoRig& rig, const StereoRig& ma
 }
 
 }  // namespace
+
+void writeJson(const std::string& path, const nlohmann::json& j) {
+  std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code error;
+  if (!parent.empty()) std::filesystem::create_directories(parent, error);
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write '" + path + "'");
+  out << j.dump(2) << "\n";
+}
+
+std::unique_ptr<BudgetController> makeBudgetController(double budgetMs, const std::string& profilePath, const Scene& scene,
+                                                       const RenderOptions& options, const StereoRig& rig,
+                                                       const std::string& acuity, std::optional<FoveationMask>& mask) {
+  if (budgetMs == 0) return nullptr;
+  if (!(budgetMs > 0.0) || !std::isfinite(budgetMs) || budgetMs > 10000.0)
+    throw Error("--budget-ms must be a positive number of milliseconds (at most 10000)");
+  const ControlProfile profile = profilePath.empty() ? ControlProfile::generic(scene.effectGroupNames())
+                                                     : ControlProfile::load(profilePath, scene.effectGroupNames());
+  const FoveationMask* fovea = options.foveation.mask;
+  if (!fovea && options.density == DensityScheme::PerPixel) {
+    MaskParams params = maskParamsForRig(rig);
+    if (acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
+    mask = generateFoveationMask(params);
+    fovea = &*mask;
+  }
+  BudgetControllerParams params;
+  params.budgetMs = budgetMs;
+  params.foveationAvailable = fovea != nullptr;
+  return std::make_unique<BudgetController>(profile, params, options, fovea);
+}
 
 int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
   catchStopSignals();
@@ -158,6 +179,10 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::printf("xr offscreen: %s backend (%s), eyes %dx%d, %.0f Hz slots%s, hand-over %s\n", renderer.backendName().c_str(),
                 renderer.deviceName().c_str(), setup.rig.width, setup.rig.height, args.refreshHz, args.paced ? " (paced)" : "",
                 run["handover"].get<std::string>().c_str());
+    std::optional<FoveationMask> controlMask;
+    std::unique_ptr<BudgetController> controller = makeBudgetController(
+        args.budgetMs, args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
+    lo.controller = controller.get();
     stats = FrameLoop(renderer, presenter).run(lo);
     auto skipWarmup = [&](std::vector<double> v) {
       if (v.size() > args.warmup) v.erase(v.begin(), v.begin() + long(args.warmup));
@@ -201,6 +226,10 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                 info.colourFormat.c_str(), info.depthLayer ? "on" : "off", info.eyeTracker ? "yes" : "no (gaze from --gaze)");
     std::printf("  %s backend (%s), hand-over %s, %s space\n", renderer.backendName().c_str(), renderer.deviceName().c_str(),
                 info.handOver.c_str(), info.space.c_str());
+    std::optional<FoveationMask> controlMask;
+    std::unique_ptr<BudgetController> controller = makeBudgetController(
+        args.budgetMs, args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
+    lo.controller = controller.get();
     stats = FrameLoop(renderer, presenter).run(lo);
     run["presenter"] = "openxr";
     run["runtime"] = info.runtime;
@@ -298,9 +327,13 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     renderer.options() = current;
     std::printf("view: %s backend (%s), eyes %dx%d\n", renderer.backendName().c_str(), renderer.deviceName().c_str(),
                 setup.rig.width, setup.rig.height);
+    std::optional<FoveationMask> controlMask;
+    std::unique_ptr<BudgetController> controller = makeBudgetController(
+        args.budgetMs, args.controllerProfile, *setup.scene, current, renderer.rig(), args.acuity, controlMask);
+    lo.controller = controller.get();
     FrameStats stats = FrameLoop(renderer, viewer).run(lo);
     std::printf("%s", stats.summary().c_str());
-    current = renderer.options();
+    if (!controller) current = renderer.options();  // a controller's are its own: the panel's stay as asked
     if (!viewer.backendChangeRequested()) break;
     viewer.clearBackendChange();
     kind = viewer.settings().backend ? BackendKind::Cuda : BackendKind::Cpu;

@@ -4,7 +4,12 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+#include <optional>
+
 #include "pvr/app/trajectory.h"
+#include "pvr/control/budget_controller.h"
+#include "pvr/foveation/mask.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 
@@ -31,7 +36,19 @@ struct LoopCommandArgs {
   bool noPanel = false;
   std::string sceneName;         ///< as given, for the settings file
   std::string acuity = "linear";
+  double budgetMs = 0;            ///< > 0: the budget controller runs the loop's options
+  std::string controllerProfile;  ///< empty: ControlProfile::generic
 };
+
+// Writes `j` (indented) to `path`, making its folder; throws pvr::Error if it cannot.
+void writeJson(const std::string& path, const nlohmann::json& j);
+
+// --budget-ms: the controller for a scene's effect groups, from the options the user asked for and
+// the final rig; its foveation knob uses the options' mask, or one made for the rig into `mask`.
+// Null for budgetMs <= 0. Throws pvr::Error for a bad profile or budget.
+std::unique_ptr<BudgetController> makeBudgetController(double budgetMs, const std::string& profilePath, const Scene& scene,
+                                                       const RenderOptions& options, const StereoRig& rig,
+                                                       const std::string& acuity, std::optional<FoveationMask>& mask);
 
 struct LoopSetup {
   BackendKind backend = BackendKind::Auto;

@@ -16,6 +16,10 @@ FrameStats FrameLoop::run(const FrameLoopOptions& options) {
   uint64_t rendered = 0;
   bool stopRequested = false;
   std::optional<LoopClock::time_point> previousStart;
+  const LoopClock::time_point loopStart = LoopClock::now();
+  BudgetController* controller = options.controller;
+  RenderOptions asked = renderer_.options();  // under a controller: what the user asks for, the presenter adjusts
+  ControlLog control;
   for (;;) {
     const bool stopNow = (options.stop && options.stop->load()) ||
                          (options.maxFrames && rendered >= options.maxFrames + options.warmupFrames);
@@ -26,7 +30,15 @@ FrameStats FrameLoop::run(const FrameLoopOptions& options) {
     LoopClock::time_point waitStart = LoopClock::now();
     if (!presenter_.waitFrame(request)) break;
     LoopClock::time_point start = LoopClock::now();
-    presenter_.adjustOptions(renderer_.options());
+    std::optional<ControlDecision> decision;
+    if (controller) {
+      presenter_.adjustOptions(asked);
+      controller->setBase(asked);
+      decision = controller->decide(msBetween(loopStart, start));
+      renderer_.options() = controller->optionsFor(decision->setting);
+    } else {
+      presenter_.adjustOptions(renderer_.options());
+    }
     FrameRecord record;
     record.waitMs = msBetween(waitStart, start);
     record.intervalMs = previousStart ? msBetween(*previousStart, start) : 0.0;
@@ -55,8 +67,13 @@ FrameStats FrameLoop::run(const FrameLoopOptions& options) {
       record.slackMs = msBetween(done, *request.deadline);
       record.missedDeadline = done > *request.deadline;
     }
-    if (rendered++ >= options.warmupFrames) stats.add(record);
+    if (controller) controller->observe(ControlCosts::of(frame.timings, record.cpuMs));
+    if (rendered++ >= options.warmupFrames) {
+      stats.add(record);
+      if (controller) control.add(*decision, record.cpuMs, ControlCosts::of(frame.timings, record.cpuMs));
+    }
   }
+  if (controller) stats.setControl(controller, std::move(control));
   return stats;
 }
 

@@ -38,7 +38,7 @@ nlohmann::json FrameStats::toJson() const {
   std::vector<double> slack;
   for (const FrameRecord& r : records_)
     if (r.hasDeadline) slack.push_back(r.slackMs);
-  return {{"frames", frames()},
+  nlohmann::json out = {{"frames", frames()},
           {"skipped", skipped_},
           {"frames_with_deadline", framesWithDeadline()},
           {"missed_deadlines", missedDeadlines()},
@@ -59,6 +59,8 @@ nlohmann::json FrameStats::toJson() const {
             {"right_eye_rays", stage([](const StageTimings& t) { return t.eyeRayMs[1]; })},
             {"left_eye", stage([](const StageTimings& t) { return t.eyeMs[0]; })},
             {"right_eye", stage([](const StageTimings& t) { return t.eyeMs[1]; })}}}};
+  if (controller_) out["controller"] = control_.toJson(*controller_);
+  return out;
 }
 
 std::string FrameStats::summary() const {
@@ -77,6 +79,7 @@ std::string FrameStats::summary() const {
   row("hand-over to display", present());
   row("loop overhead", overhead());
   row("frame-to-frame", interval());
+  if (controller_) text += control_.summary(*controller_);
   return text;
 }
 

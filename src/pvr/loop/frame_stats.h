@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pvr/control/budget_controller.h"
 #include "pvr/pipeline/frame_result.h"
 #include "pvr/util/latency_stats.h"
 
@@ -30,6 +31,8 @@ class FrameStats {
  public:
   void add(const FrameRecord& record) { records_.push_back(record); }
   void addSkipped() { ++skipped_; }  ///< a frame the display did not want rendered
+  // A controlled loop's decisions (toJson's "controller" and the summary's last line).
+  void setControl(const BudgetController* controller, ControlLog log) { controller_ = controller, control_ = std::move(log); }
   size_t frames() const { return records_.size(); }
   size_t skipped() const { return skipped_; }
   size_t missedDeadlines() const;
@@ -51,6 +54,8 @@ class FrameStats {
  private:
   std::vector<FrameRecord> records_;
   size_t skipped_ = 0;
+  const BudgetController* controller_ = nullptr;
+  ControlLog control_;
 };
 
 }  // namespace pvr

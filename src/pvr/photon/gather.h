@@ -33,15 +33,20 @@ struct GatherParams {
   // Sample 0's first hits rasterised (the G-buffer pre-pass), set by the backend for one eye pass;
   // none: traced. Ignored when the first sample is jittered.
   PrimaryHitsView primary;
-  // Every material's effect level replaced by `effects` (else each surface's own, Material::effect).
+  // Every material's effect level replaced by `effects`; else its group's level where that is
+  // set (not kOwnEffectLevel), else the surface's own (Material::effect).
   bool overrideEffects = false;
   EffectLevel effects = EffectLevel::Gi;
+  uint8_t groupEffects[kMaxEffectGroups] = {kOwnEffectLevel, kOwnEffectLevel, kOwnEffectLevel, kOwnEffectLevel,
+                                            kOwnEffectLevel, kOwnEffectLevel, kOwnEffectLevel, kOwnEffectLevel};
   int pathDepth = 8;  ///< EffectLevel::Path: bounces of its indirect paths (Russian roulette after 3)
 };
 
 // The effect level the eye paths use at a surface of material m.
 PVR_HOST_DEVICE inline EffectLevel effectLevelOf(const GatherParams& params, const Material& m) {
-  return params.overrideEffects ? params.effects : m.effect;
+  if (params.overrideEffects) return params.effects;
+  const uint8_t group = params.groupEffects[m.effectGroup];
+  return group == kOwnEffectLevel ? m.effect : EffectLevel(group);
 }
 
 // Shadow rays that always reach their light: EffectLevel::Raster's direct light.

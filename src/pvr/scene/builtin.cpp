@@ -110,7 +110,10 @@ Scene cornellBox(CornellContents contents) {
           cornell(213, 548.3f, 227), mLight);
 
   if (contents == CornellContents::DenseSphere) {
-    addBumpySphere(scene, "bumpy sphere", {0.0f, 0.3f, -0.05f}, 0.26f, 1024, 640, mWhite);
+    // The walls' white, its own material so that it is an effect group of its own.
+    const uint32_t mSphere = scene.addMaterial(white, "sphere");
+    scene.setEffectGroup(mSphere, scene.addEffectGroup("sphere"));
+    addBumpySphere(scene, "bumpy sphere", {0.0f, 0.3f, -0.05f}, 0.26f, 1024, 640, mSphere);
   } else if (!caustics) {
     const Vec3 shortTop[4] = {cornell(130, 165, 65), cornell(82, 165, 225), cornell(240, 165, 272), cornell(290, 165, 114)};
     const Vec3 tallTop[4] = {cornell(423, 330, 247), cornell(265, 330, 296), cornell(314, 330, 456), cornell(472, 330, 406)};
@@ -125,6 +128,9 @@ Scene cornellBox(CornellContents contents) {
     glass.ior = 1.5f;
     uint32_t mMirror = scene.addMaterial(mirror, "mirror");
     uint32_t mGlass = scene.addMaterial(glass, "glass");
+    const uint32_t specular = scene.addEffectGroup("specular");
+    scene.setEffectGroup(mMirror, specular);
+    scene.setEffectGroup(mGlass, specular);
     const float r = 0.17f;
     addSphere(scene, "mirror sphere", {-0.2f, r, -0.22f}, r, mMirror);
     addSphere(scene, "glass sphere", {0.2f, r + 0.02f, 0.1f}, r, mGlass);

@@ -13,6 +13,29 @@ uint32_t Scene::addMaterial(const Material& m, const std::string& materialName) 
   return uint32_t(materials_.size() - 1);
 }
 
+uint32_t Scene::addEffectGroup(const std::string& groupName) {
+  if (effectGroupIndex(groupName) >= 0) throw Error("effect group '" + groupName + "' is named twice");
+  if (effectGroupNames_.size() >= size_t(kMaxEffectGroups))
+    throw Error("more than " + std::to_string(kMaxEffectGroups - 1) + " effect groups");
+  effectGroupNames_.push_back(groupName);
+  return uint32_t(effectGroupNames_.size() - 1);
+}
+
+void Scene::setEffectGroup(uint32_t material, uint32_t group) {
+  if (group >= effectGroupNames_.size()) throw Error("no effect group " + std::to_string(group));
+  materials_.at(material).effectGroup = group;
+}
+
+int Scene::effectGroupIndex(const std::string& groupName) const {
+  auto it = std::find(effectGroupNames_.begin(), effectGroupNames_.end(), groupName);
+  return it == effectGroupNames_.end() ? -1 : int(it - effectGroupNames_.begin());
+}
+
+int Scene::materialIndex(const std::string& materialName) const {
+  auto it = std::find(materialNames_.begin(), materialNames_.end(), materialName);
+  return it == materialNames_.end() ? -1 : int(it - materialNames_.begin());
+}
+
 void Scene::addMesh(const std::string& meshName, const std::vector<Vec3>& vertices, const std::vector<Vec3>& normals,
                     const std::vector<uint32_t>& indices, uint32_t materialId) {
   static const std::vector<Vec2> none[2];
@@ -185,6 +208,7 @@ Scene& Scene::operator=(const Scene& other) {
   for (size_t i = 0; i < textures_.size(); ++i) textures_[i].texels = textureTexels_[i].data();
   materials_ = other.materials_;
   materialNames_ = other.materialNames_;
+  effectGroupNames_ = other.effectGroupNames_;
   meshes_ = other.meshes_;
   lightTriangles_ = other.lightTriangles_;
   punctualLights_ = other.punctualLights_;

@@ -64,6 +64,13 @@ class Scene {
   const std::vector<MeshRange>& meshes() const { return meshes_; }
   const std::vector<Material>& materials() const { return materials_; }
   void setEffect(uint32_t material, EffectLevel level) { materials_.at(material).effect = level; }
+  // Effect groups: names by index, "rest" (group 0, every material not put in another) first.
+  // addEffectGroup throws pvr::Error past kMaxEffectGroups or for a name already taken.
+  uint32_t addEffectGroup(const std::string& name);
+  void setEffectGroup(uint32_t material, uint32_t group);  ///< throws pvr::Error for an unknown group
+  const std::vector<std::string>& effectGroupNames() const { return effectGroupNames_; }
+  int effectGroupIndex(const std::string& name) const;  ///< -1: no such group
+  int materialIndex(const std::string& name) const;     ///< the first material of that name, -1: none
   const std::vector<std::string>& materialNames() const { return materialNames_; }
   // Index of the mesh that holds a triangle, or -1.
   int meshOfTriangle(uint32_t prim) const;
@@ -88,6 +95,7 @@ class Scene {
   std::vector<TextureView> textures_;
   std::vector<Material> materials_;
   std::vector<std::string> materialNames_;
+  std::vector<std::string> effectGroupNames_{"rest"};
   std::vector<MeshRange> meshes_;
   std::vector<uint32_t> lightTriangles_;
   std::vector<PunctualLight> punctualLights_;

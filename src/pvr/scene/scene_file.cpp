@@ -124,7 +124,7 @@ Scene loadJsonScene(const std::string& path) {
   }
   try {
     if (!doc.is_object()) throw Error("the top level must be an object");
-    checkKeys(doc, "the scene file", {"base", "meshes", "lights", "camera", "effects"});
+    checkKeys(doc, "the scene file", {"base", "meshes", "lights", "camera", "effects", "effect_groups"});
     auto effectLevel = [](const json& j, const std::string& what) {
       EffectLevel level;
       if (!j.is_string() || !effectLevelFromName(j.get<std::string>(), level))
@@ -229,6 +229,27 @@ Scene loadJsonScene(const std::string& path) {
         for (size_t i = 0; i < scene.materials().size(); ++i)
           if (scene.materialNames()[i] == name) scene.setEffect(uint32_t(i), level), found = true;
         if (!found) throw Error("'effects' names material '" + name + "', which the scene does not have");
+      }
+    }
+    if (doc.contains("effect_groups")) {  // {"floor": ["sp_00_pod"], ...}: what --effects GROUP=LEVEL and the controller set
+      if (!doc["effect_groups"].is_object()) throw Error("'effect_groups' must map group names to lists of material names");
+      for (const auto& [group, members] : doc["effect_groups"].items()) {
+        if (group.empty() || group == "rest" || group.find_first_of("=,") != std::string::npos)
+          throw Error("effect group name '" + group + "' is reserved or holds '=' or ','");
+        if (!members.is_array() || members.empty()) throw Error("effect group '" + group + "' must list material names");
+        const uint32_t g = scene.addEffectGroup(group);
+        for (const json& member : members) {
+          if (!member.is_string()) throw Error("effect group '" + group + "' must list material names");
+          bool found = false;
+          for (size_t i = 0; i < scene.materials().size(); ++i)
+            if (scene.materialNames()[i] == member.get<std::string>()) {
+              if (scene.materials()[i].effectGroup != 0)
+                throw Error("material '" + member.get<std::string>() + "' is in two effect groups");
+              scene.setEffectGroup(uint32_t(i), g), found = true;
+            }
+          if (!found)
+            throw Error("effect group '" + group + "' names material '" + member.get<std::string>() + "', which the scene does not have");
+        }
       }
     }
     scene.finalize();

@@ -27,6 +27,11 @@ enum class EffectLevel : uint32_t {
   Path = 4,         ///< indirect light path traced instead (next-event estimation, Russian roulette)
 };
 constexpr int kEffectLevels = 5;
+// Materials fall into effect groups (Ray-VR's "statues and wall decorations"): a scene names up
+// to this many, group 0 being every material no group names; RenderOptions may set each group's
+// level at run time (GatherParams::groupEffects), as the budget controller does.
+constexpr int kMaxEffectGroups = 8;
+constexpr uint8_t kOwnEffectLevel = 0xFF;  ///< a group whose materials keep their own levels
 PVR_HOST_DEVICE constexpr const char* effectLevelName(EffectLevel level) {
   return level == EffectLevel::Raster ? "raster" : level == EffectLevel::Shadows ? "shadows"
          : level == EffectLevel::Reflections ? "reflections" : level == EffectLevel::Gi ? "gi" : "path";
@@ -57,6 +62,7 @@ struct Material {
   float alpha = 1.0f;             ///< baseColorFactor's alpha
   float alphaCutoff = 0.5f;       ///< MASK: texels with alpha below this are cut out
   EffectLevel effect = EffectLevel::Gi;  ///< what the eye paths do at this surface (RenderOptions may override it)
+  uint32_t effectGroup = 0;              ///< its effect group (Scene::effectGroupNames), below kMaxEffectGroups
 
   // Every texture reference, for validation.
   std::array<const TextureRef*, 8> textureRefs() const {

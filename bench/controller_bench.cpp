@@ -1,0 +1,257 @@
+#include "controller_bench.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "bench_util.h"
+#include "pvr/app/options.h"
+#include "pvr/app/trajectory.h"
+#include "pvr/control/budget_controller.h"
+#include "pvr/foveation/mask.h"
+#include "pvr/image/image_compare.h"
+#include "pvr/reference/progressive_reference.h"
+#include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
+#include "pvr/util/latency_stats.h"
+
+namespace pvr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// One walk at one policy (the controller, or a fixed setting).
+struct Walk {
+  std::string name;
+  std::vector<double> ms;                   ///< per frame
+  std::vector<std::pair<int, double>> error;  ///< (frame, mean relMSE of the eyes) at sampled frames
+  ControlLog log;                           ///< the controller's
+  std::map<std::string, int> settingFrames;  ///< the controller's time in each setting
+  double p99() const { return latencyStats(ms).p99; }
+  double overFraction(double budget) const {
+    return double(std::count_if(ms.begin(), ms.end(), [&](double m) { return m > budget; })) / double(std::max<size_t>(ms.size(), 1));
+  }
+  double meanError() const {
+    double s = 0;
+    for (const auto& e : error) s += e.second;
+    return error.empty() ? 0.0 : s / double(error.size());
+  }
+};
+
+struct SampledView {
+  int frame;
+  std::array<Image, 2> reference;
+};
+
+double frameError(const FrameResult& f, const SampledView& v) {
+  return 0.5 * (compareToReference(f.eyes[0].image, v.reference[0]).relMse + compareToReference(f.eyes[1].image, v.reference[1]).relMse);
+}
+
+// Renders the walk: `choose` gives each frame's options (and sees its measured time after).
+template <class Choose, class Observe>
+Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFrame>& trajectory,
+          const std::vector<SampledView>& views, Choose choose, Observe observe) {
+  Walk w;
+  renderer.resetHistory();
+  size_t nextView = 0;
+  const auto start = Clock::now();
+  for (size_t f = 0; f < trajectory.size(); ++f) {
+    rig.head = trajectory[f].head;
+    RenderOptions o = choose(msSince(start));
+    std::copy(&trajectory[f].gaze[0][0], &trajectory[f].gaze[0][0] + 4, &o.foveation.gaze[0][0]);
+    o.foveation.verge = trajectory[f].verge;
+    const auto frameStart = Clock::now();
+    FrameResult frame = renderer.render(rig, o, false);
+    const double ms = msSince(frameStart);
+    w.ms.push_back(ms);
+    observe(frame.timings, ms);
+    if (nextView < views.size() && views[nextView].frame == int(f)) {
+      // The shown image of this frame, read back outside the timed frame (a second render of the
+      // same view: the temporal stages see it once more).
+      const FrameResult shown = renderer.render(rig, o, true);
+      w.error.push_back({int(f), frameError(shown, views[nextView])});
+      ++nextView;
+    }
+  }
+  return w;
+}
+
+}  // namespace
+
+int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json) {
+  int failures = 0;
+  if (args.walks.empty()) throw Error("--walks must name SCENE=TRAJECTORY pairs for the controller suite");
+  if (args.referencePasses < 2 || args.referencePasses > kMaxReferencePasses)
+    throw Error("--reference-passes must be between 2 and " + std::to_string(kMaxReferencePasses));
+  if (args.errorEvery < 1) throw Error("--error-every must be at least 1");
+  std::vector<double> budgets;
+  for (const std::string& b : splitList(args.budgets)) {
+    char* end = nullptr;
+    const double v = std::strtod(b.c_str(), &end);
+    if (end == b.c_str() || *end != 0 || !std::isfinite(v)) throw Error("--budgets must be numbers of ms, got '" + b + "'");
+    if (!(v > 0.0) || v > 10000.0) throw Error("--budgets must be positive milliseconds, got '" + b + "'");
+    budgets.push_back(v);
+  }
+  std::printf("\nThe budget controller on walks through scenes: frame time (host wall time of the stereo frame, images "
+              "left on the device) mean / p50 / p99 and frames over the budget; error: mean relMSE of both eyes against "
+              "converged references (%d passes of 1024x1024 photons) of every %dth frame's view. Fixed settings: each "
+              "setting the controller spent at least 2 %% of a walk in, and uniform ones.\n\n",
+              args.referencePasses, args.errorEvery);
+  for (const std::string& item : splitList(args.walks)) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos) throw Error("--walks: '" + item + "' is not SCENE=TRAJECTORY");
+    const std::string sceneName = item.substr(0, eq);
+    Scene scene;
+    try {
+      scene = loadScene(sceneName);
+    } catch (const Error& e) {
+      std::printf("| %s | skipped: %s |\n", sceneName.c_str(), e.what());
+      continue;
+    }
+    const std::vector<TrajectoryFrame> trajectory = loadTrajectory(item.substr(eq + 1));
+    StereoRig rig = scene.rig;
+    if (!args.eyeSize.empty()) setEyeSize(rig, args.eyeSize);
+    std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
+    const std::vector<std::string> builtins = builtinSceneNames();
+    const bool builtin = std::find(builtins.begin(), builtins.end(), sceneName) != builtins.end();
+    RenderOptions base;
+    base.gather.density.radius = builtin ? RenderOptions().gather.density.radius : args.sceneRadius;
+    base.gather.mode = ShadingMode::Full;
+    // The profile: PREFIX_<scene>.json from the effects suite if there is one.
+    std::string file = scene.name;
+    std::replace_if(file.begin(), file.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)) && ch != '-'; }, '_');
+    const std::string profilePath = args.profiles.empty() ? "" : args.profiles + "_" + file + ".json";
+    const bool calibrated = !profilePath.empty() && std::filesystem::exists(profilePath);
+    const ControlProfile profile = calibrated ? ControlProfile::load(profilePath, scene.effectGroupNames())
+                                              : ControlProfile::generic(scene.effectGroupNames());
+    const FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
+    // The sampled views' references.
+    std::vector<SampledView> views;
+    for (size_t f = 0; f < trajectory.size(); f += size_t(args.errorEvery)) {
+      StereoRig vr = rig;
+      vr.head = trajectory[f].head;
+      RenderOptions ro = base;
+      ro.photonsX = ro.photonsY = 1024;
+      ro.gather.punctualShadowRays = 0;
+      ro.gather.seed = 0x5eed + uint32_t(f);
+      ro.map = PhotonMapKind::KdTree;
+      ReferenceSettings settings;
+      settings.boxFilter = false;
+      ProgressiveReference reference(*renderer, vr, ro, settings);
+      for (int i = 0; i < args.referencePasses; ++i) reference.addPass();
+      views.push_back({int(f), {reference.image(Eye::Left), reference.image(Eye::Right)}});
+    }
+    std::printf("| %s | %zu frames, %dx%d per eye, radius %g, profile %s, %zu reference views |\n", scene.name.c_str(),
+                trajectory.size(), rig.width, rig.height, base.gather.density.radius,
+                calibrated ? profilePath.c_str() : "generic (no calibrated profile found)", views.size());
+    std::printf("| scene | budget | policy | frame mean / p50 / p99 | over budget | mean relMSE | meets budget | check |\n"
+                "|---|---|---|---|---|---|---|---|\n");
+    BudgetControllerParams params;
+    params.foveationAvailable = true;
+    const BudgetController model(profile, params, base, &mask);  // the ladder's settings and their options
+    std::vector<Walk> controlled;
+    std::map<std::string, ControlSetting> candidates;
+    for (double budget : budgets) {
+      params.budgetMs = budget;
+      BudgetController controller(profile, params, base, &mask);
+      ControlLog log;
+      std::optional<ControlDecision> decision;
+      Walk w = walk(*renderer, rig, trajectory, views,
+                    [&](double now) {
+                      decision = controller.decide(now);
+                      return controller.optionsFor(decision->setting);
+                    },
+                    [&](const StageTimings& t, double ms) {
+                      controller.observe(ControlCosts::of(t, ms));
+                      log.add(*decision, ms, ControlCosts::of(t, ms));
+                    });
+      for (const auto& [frame, error] : w.error) log.entries()[size_t(frame)].measuredError = error;
+      for (const ControlLogEntry& e : log.entries()) ++w.settingFrames[BudgetController::toJson(e.decision.setting, profile).dump()];
+      // The settings it spent most time in (at most 4, each at least 3 % of the walk) are run fixed.
+      std::vector<std::pair<int, std::string>> used;
+      for (const auto& [key, frames] : w.settingFrames) used.push_back({frames, key});
+      std::sort(used.rbegin(), used.rend());
+      for (size_t u = 0; u < used.size() && u < 4; ++u)
+        if (used[u].first >= int(0.03 * double(trajectory.size())))
+          for (const ControlLogEntry& e : log.entries())
+            if (BudgetController::toJson(e.decision.setting, profile).dump() == used[u].second) {
+              candidates[used[u].second] = e.decision.setting;
+              break;
+            }
+      w.name = "controller";
+      w.log = std::move(log);
+      controlled.push_back(std::move(w));
+      // Its decisions, for the plot.
+      json.push_back({{"suite", "controller"}, {"scene", scene.name}, {"budget_ms", budget}, {"policy", "controller"},
+                      {"backend", renderer->name()}, {"device", renderer->deviceName()}, {"eye_size", {rig.width, rig.height}},
+                      {"profile", calibrated ? profilePath : "generic"}, {"log", controlled.back().log.toJson(controller)}});
+    }
+    // The uniform ladder: everything at one level, the controller's best photons, radius and denoiser.
+    for (int level = 0; level < kControlledLevels; ++level) {
+      ControlSetting s = model.best();
+      for (size_t g = 0; g < profile.groups.size(); ++g) s.levels[g] = uint8_t(std::min<int>(level, s.levels[g]));
+      candidates[BudgetController::toJson(s, profile).dump()] = s;
+      if (level == int(EffectLevel::Gi)) {  // gi with the fewest photons
+        ControlSetting fewer = s;
+        fewer.photons = 0;
+        candidates[BudgetController::toJson(fewer, profile).dump()] = fewer;
+      }
+    }
+    std::vector<std::pair<std::string, Walk>> fixed;
+    for (const auto& [key, setting] : candidates) {
+      const RenderOptions o = model.optionsFor(setting);
+      Walk w = walk(*renderer, rig, trajectory, views, [&](double) { return o; }, [](const StageTimings&, double) {});
+      w.name = key;
+      fixed.emplace_back(key, std::move(w));
+    }
+    for (size_t b = 0; b < budgets.size(); ++b) {
+      const double budget = budgets[b];
+      const Walk& c = controlled[b];
+      double bestFixed = 1e30;
+      std::string bestFixedName = "none";
+      auto row = [&](const Walk& w, const std::string& name, bool isController) {
+        const LatencyStats t = latencyStats(w.ms);
+        const bool meets = t.p99 <= budget && w.overFraction(budget) <= 0.005;
+        if (!isController && meets && w.meanError() < bestFixed) bestFixed = w.meanError(), bestFixedName = name;
+        return std::make_tuple(t, meets);
+      };
+      for (const auto& [name, w] : fixed) row(w, name, false);
+      const auto [ct, cMeets] = row(c, "controller", true);
+      const bool ok = cMeets && c.meanError() < bestFixed;
+      failures += ok ? 0 : 1;
+      std::printf("| %s | %.2f ms | controller (%zu changes) | %.2f / %.2f / %.2f | %.2f %% | %.4f | %s | %s |\n",
+                  scene.name.c_str(), budget, c.log.changes(), ct.mean, ct.p50, ct.p99, 100.0 * c.overFraction(budget),
+                  c.meanError(), cMeets ? "yes" : "no", ok ? "ok" : "MISSED");
+      for (const auto& [name, w] : fixed) {
+        const auto [t, meets] = row(w, name, false);
+        std::printf("| %s | %.2f ms | fixed %s | %.2f / %.2f / %.2f | %.2f %% | %.4f | %s | %s |\n", scene.name.c_str(),
+                    budget, name.c_str(), t.mean, t.p50, t.p99, 100.0 * w.overFraction(budget), w.meanError(),
+                    meets ? "yes" : "no", name == bestFixedName ? "best fixed that meets it" : "");
+      }
+      json.push_back({{"suite", "controller"}, {"scene", scene.name}, {"budget_ms", budget}, {"policy", "summary"},
+                      {"controller", {{"frame", ct}, {"over_fraction", c.overFraction(budget)}, {"mean_rel_mse", c.meanError()},
+                                      {"changes", c.log.changes()}}},
+                      {"best_fixed", bestFixedName}, {"best_fixed_mean_rel_mse", bestFixed < 1e30 ? bestFixed : -1.0},
+                      {"check", ok ? "ok" : "MISSED"}});
+    }
+    for (const auto& [name, w] : fixed) {
+      nlohmann::json frames = w.ms, errors = nlohmann::json::array();
+      for (const auto& [frame, error] : w.error) errors.push_back({frame, error});
+      json.push_back({{"suite", "controller"}, {"scene", scene.name}, {"policy", "fixed"}, {"setting", nlohmann::json::parse(name)},
+                      {"frame", latencyStats(w.ms)}, {"mean_rel_mse", w.meanError()}, {"frame_ms", frames}, {"errors", errors}});
+    }
+  }
+  return failures;
+}
+
+}  // namespace pvr

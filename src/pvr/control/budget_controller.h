@@ -1,0 +1,175 @@
+#pragma once
+// The automatic controller that Ray-VR (section VI) names as future work: given a frame budget
+// (11.1 ms at 90 Hz, or the display's period) it chooses, frame by frame, the photon count, the
+// search radius, foveation, the denoiser and the effect level of each material group, so that the
+// p99 frame time stays under the budget while the image loses the least quality.
+//
+// Cost model: every frame's measured stage times are divided by how that stage scales with the
+// frame's setting (photon trace and map build ~ photons; density ~ photons x radius^2, the photons
+// a query meets, x the share of the gather points at level gi x the shaded samples; eye rays ~ the
+// groups' level costs x the shaded samples; denoising ~ iterations; the rest is constant), which
+// leaves unit costs that depend on the view only. A candidate's time is the largest unit costs of
+// the last few frames times its scales: the view's cost is tracked as it changes, settings are
+// compared on equal terms.
+// Quality model: each knob's added error (relMSE against the converged reference) measured alone
+// at a calibration view, summed (ControlProfile; `bench --suite effects --profile-out` makes one).
+// It starts by probing the view at the fewest photons, then takes the best setting that fits.
+// Hysteresis: the setting is lowered at once, as far as needed, when the predicted time of the
+// current one passes budget x (1 - margin); it is raised by at most two knob steps at a time (one
+// up, or one up and one down), only after the headroom has held for `holdFrames` frames, at most
+// `maxRaisesPerSecond`, and only for a gain above `minGain`: no oscillation, no popping.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pvr/pipeline/frame_options.h"
+#include "pvr/pipeline/frame_result.h"
+
+namespace pvr {
+
+// The levels the controller chooses among (Path accumulates while the head is still: not a
+// per-frame choice).
+constexpr int kControlledLevels = 4;  // raster, shadows, reflections, gi
+
+// One point of the controller's search space: an index into each of the profile's ladders.
+struct ControlSetting {
+  int photons = 0;      ///< ControlProfile::photonSides
+  int radius = 0;       ///< ControlProfile::radiusScales
+  int denoise = 0;      ///< ControlProfile::denoiseIterations (0 iterations: off)
+  bool foveated = false;
+  std::array<uint8_t, kMaxEffectGroups> levels{};  ///< per effect group, an EffectLevel below Path
+  bool operator==(const ControlSetting&) const = default;
+};
+
+// What the controller knows of a scene, calibrated offline (or the built-in generic model).
+struct ControlProfile {
+  std::string scene, device;  ///< what it was calibrated on (informative)
+  std::vector<std::string> groups{"rest"};  ///< the scene's effect groups, group 0 first
+  std::vector<uint32_t> photonSides{128, 181, 256, 362, 512, 724, 1024};  ///< emitted photons = side^2
+  std::vector<float> radiusScales{0.7f, 1.0f, 1.4f};  ///< times the radius the options ask for
+  std::vector<int> denoiseIterations{0, 2, 4};
+  // Quality: relMSE of the best setting, and what each knob's step adds to it (may be negative:
+  // the denoiser lowers the error).
+  double topError = 0.02;
+  std::vector<double> photonError, radiusError, denoiseError;  ///< one per ladder step
+  double foveatedError = 0.01;
+  std::vector<std::array<double, kControlledLevels>> levelError;  ///< per group, per level (gi: 0)
+  // Cost shapes: eye-ray time of each group's level relative to all at gi (whose eye rays are
+  // 1), the share of the density work each group's gather points do, the shaded samples of the
+  // foveated frame over the pixels.
+  std::vector<std::array<double, kControlledLevels>> levelRayCost;  ///< per group, per level: added to 1
+  std::vector<double> densityShare;  ///< per group; the shares sum to 1
+  double foveatedSamples = 0.25;
+  double denoiseMsPerIteration = 0.2;  ///< until a denoised frame has been measured
+
+  // The generic model for a scene with these groups: variance ~ 1 / (photons x radius^2), bias ~
+  // radius^2, each group's levels by its share, the foveated frame 4x cheaper.
+  static ControlProfile generic(const std::vector<std::string>& groups);
+  // A profile file (JSON, as toJson writes); throws pvr::Error naming the file and what is wrong,
+  // including ladders out of range and groups the scene does not have.
+  static ControlProfile load(const std::string& path, const std::vector<std::string>& sceneGroups);
+  nlohmann::json toJson() const;
+  void validate() const;  ///< throws pvr::Error: sizes, ranges, non-finite values
+};
+
+struct BudgetControllerParams {
+  double budgetMs = 1000.0 / 90.0;
+  double margin = 0.12;         ///< the predicted time must stay under budget x (1 - margin)
+  double raiseHeadroom = 0.06;  ///< raising needs the new setting under budget x (1 - margin - this)
+  int holdFrames = 10;          ///< frames of headroom before a raise
+  double maxRaisesPerSecond = 4.0;
+  double minGain = 0.03;        ///< a raise must lower the predicted error by this fraction
+  int window = 6;               ///< frames whose unit costs the prediction takes the largest of
+  bool foveationAvailable = false;  ///< a mask exists to switch to
+};
+
+// The controller's decision for one frame, for the stats.
+struct ControlDecision {
+  ControlSetting setting;
+  double predictedMs = 0, predictedError = 0;
+  const char* change = "hold";  ///< "hold" | "lower" | "raise" | "start"
+};
+
+// Per-frame measured stage times, in the terms of the cost model.
+struct ControlCosts {
+  double photonMs = 0;   ///< photon trace + map build
+  double densityMs = 0;  ///< both eyes
+  double rayMs = 0;      ///< both eyes' eye rays
+  double denoiseMs = 0;  ///< both eyes
+  double restMs = 0;     ///< the frame's time minus the above
+  static ControlCosts of(const StageTimings& t, double frameMs);
+  double total() const { return photonMs + densityMs + rayMs + denoiseMs + restMs; }
+};
+
+class BudgetController {
+ public:
+  // `base`: the options the user asked for (radius, effect levels, denoiser parameters); the
+  // controller starts from the best setting and writes each frame's into a copy of them.
+  BudgetController(const ControlProfile& profile, const BudgetControllerParams& params, const RenderOptions& base,
+                   const FoveationMask* mask);
+
+  // Before a frame at time `nowMs` (any monotonic clock): the setting to render with.
+  ControlDecision decide(double nowMs);
+  // New options from the user (the viewer's panel): what the knobs apply to from now on.
+  void setBase(const RenderOptions& base) { base_ = base; }
+  // The options of a setting (base with the setting's knobs applied).
+  RenderOptions optionsFor(const ControlSetting& s) const;
+  // After the frame rendered with the last decision: its measured costs.
+  void observe(const ControlCosts& measured);
+
+  // The models, for the tests and the logs.
+  double predictMs(const ControlSetting& s) const;  ///< with the current window of unit costs
+  double predictError(const ControlSetting& s) const;
+  ControlCosts scaleOf(const ControlSetting& s) const;  ///< each cost term's scale at a setting
+  const ControlSetting& best() const { return best_; }
+  const ControlSetting& current() const { return current_; }
+  const ControlProfile& profile() const { return profile_; }
+  const BudgetControllerParams& params() const { return params_; }
+
+  static nlohmann::json toJson(const ControlSetting& s, const ControlProfile& profile);
+
+ private:
+  std::vector<ControlSetting> raisesOf(const ControlSetting& s) const;
+  bool hasGi(const ControlSetting& s) const;
+
+  ControlProfile profile_;
+  BudgetControllerParams params_;
+  RenderOptions base_;
+  const FoveationMask* mask_;
+  int groups_;
+  ControlSetting best_, current_;
+  std::vector<ControlSetting> all_;  ///< every setting, for lowering
+  std::vector<ControlCosts> units_;  ///< the last frames' unit costs (ring, newest last)
+  double densityPerRay_ = -1;      ///< the unit density cost over the unit eye-ray cost, when last measured
+  int headroomFrames_ = 0;
+  double lastRaiseMs_ = -1e30;
+  bool started_ = false, settled_ = false;
+};
+
+// Every controlled frame: the decision and what the frame then cost. Its JSON (the stats file's
+// "controller") has the budget, the p99 and the frames over it, the changes, and one entry per
+// frame; `errors` may add a measured error (against a reference) to chosen frames.
+struct ControlLogEntry {
+  ControlDecision decision;
+  double frameMs = 0;
+  ControlCosts costs;
+  double measuredError = -1;  ///< < 0: not measured
+};
+class ControlLog {
+ public:
+  void add(const ControlDecision& d, double frameMs, const ControlCosts& costs) { entries_.push_back({d, frameMs, costs}); }
+  std::vector<ControlLogEntry>& entries() { return entries_; }
+  const std::vector<ControlLogEntry>& entries() const { return entries_; }
+  size_t framesOver(double budgetMs) const;
+  size_t changes() const;  ///< frames whose decision changed the setting
+  nlohmann::json toJson(const BudgetController& controller) const;
+  std::string summary(const BudgetController& controller) const;  ///< one line
+
+ private:
+  std::vector<ControlLogEntry> entries_;
+};
+
+}  // namespace pvr

@@ -1,0 +1,296 @@
+// The budget controller's logic on cost traces, without a GPU: a trace gives each frame's unit
+// costs (what the view costs at the reference setting), a frame's time is those costs times the
+// chosen setting's scales plus the trace's noise, and the controller sees each frame's measured
+// stage times one frame late, as in the loop. Deterministic: the traces are seeded.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "pvr/control/budget_controller.h"
+#include "pvr/foveation/mask.h"
+#include "pvr/util/latency_stats.h"
+#include "pvr/util/rng.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+namespace {
+
+constexpr double kFrameMs = 1000.0 / 90.0;
+
+// One frame of a trace: the view's costs at the reference setting, and a multiplicative noise.
+struct TraceFrame {
+  ControlCosts units;
+  double noise = 1.0;
+};
+
+// A walk through a scene: a base view, and from frame `heavyFrom` a view `heavy` times as costly,
+// reached over `ramp` frames (a head turning towards it), left the same way at `heavyTo`.
+std::vector<TraceFrame> walkTrace(int frames, int heavyFrom, int heavyTo, double heavy, int ramp, double noise, uint32_t seed) {
+  std::vector<TraceFrame> trace;
+  CounterRng rng(seed, 0, 0);
+  for (int f = 0; f < frames; ++f) {
+    double t = 0;
+    if (f >= heavyFrom && f < heavyTo) t = std::min(1.0, double(f - heavyFrom + 1) / ramp);
+    if (f >= heavyTo) t = std::max(0.0, 1.0 - double(f - heavyTo + 1) / ramp);
+    const double k = 1.0 + (heavy - 1.0) * t;
+    TraceFrame tf;
+    tf.units.photonMs = 2.0;  // the photons cost what they cost wherever the head looks
+    tf.units.densityMs = 3.0 * k;
+    tf.units.rayMs = 4.0 * k;
+    tf.units.denoiseMs = 0.3;
+    tf.units.restMs = 0.5;
+    tf.noise = 1.0 + noise * (2.0 * rng.uniform() - 1.0);
+    trace.push_back(tf);
+  }
+  return trace;
+}
+
+// What a frame at setting s costs on the trace's frame (the plant).
+ControlCosts frameCosts(const BudgetController& c, const ControlSetting& s, const TraceFrame& f) {
+  const ControlCosts scale = c.scaleOf(s);
+  ControlCosts out;
+  out.photonMs = f.units.photonMs * scale.photonMs * f.noise;
+  out.densityMs = f.units.densityMs * scale.densityMs * f.noise;
+  out.rayMs = f.units.rayMs * scale.rayMs * f.noise;
+  out.denoiseMs = f.units.denoiseMs * scale.denoiseMs * f.noise;
+  out.restMs = f.units.restMs * scale.restMs * f.noise;
+  return out;
+}
+
+struct SimRun {
+  std::vector<double> ms, error;
+  int raises = 0, lowers = 0;
+  std::vector<double> raiseTimes;
+  double p99() const { return latencyStats(ms).p99; }
+  double over(double budget) const {
+    return double(std::count_if(ms.begin(), ms.end(), [&](double m) { return m > budget; })) / double(ms.size());
+  }
+  double meanError() const {
+    double s = 0;
+    for (double e : error) s += e;
+    return s / double(error.size());
+  }
+};
+
+SimRun simulate(BudgetController& c, const std::vector<TraceFrame>& trace) {
+  SimRun run;
+  for (size_t f = 0; f < trace.size(); ++f) {
+    const double now = double(f) * kFrameMs;
+    const ControlDecision d = c.decide(now);
+    if (std::string(d.change) == "raise") ++run.raises, run.raiseTimes.push_back(now);
+    if (std::string(d.change) == "lower") ++run.lowers;
+    const ControlCosts costs = frameCosts(c, d.setting, trace[f]);
+    run.ms.push_back(costs.total());
+    run.error.push_back(c.predictError(d.setting));
+    c.observe(costs);
+  }
+  return run;
+}
+
+// A fixed setting over the same trace.
+SimRun simulateFixed(const BudgetController& c, const ControlSetting& s, const std::vector<TraceFrame>& trace) {
+  SimRun run;
+  for (const TraceFrame& f : trace) run.ms.push_back(frameCosts(c, s, f).total()), run.error.push_back(c.predictError(s));
+  return run;
+}
+
+std::vector<ControlSetting> everySetting(const ControlProfile& p, bool foveation) {
+  std::vector<ControlSetting> out;
+  const int groups = int(p.groups.size());
+  const int levelCombos = int(std::pow(kControlledLevels, groups));
+  for (int ph = 0; ph < int(p.photonSides.size()); ++ph)
+    for (int r = 0; r < int(p.radiusScales.size()); ++r)
+      for (int d = 0; d < int(p.denoiseIterations.size()); ++d)
+        for (int fv = 0; fv < (foveation ? 2 : 1); ++fv)
+          for (int l = 0; l < levelCombos; ++l) {
+            ControlSetting s;
+            s.photons = ph, s.radius = r, s.denoise = d, s.foveated = fv != 0;
+            for (int g = 0, rest = l; g < groups; ++g, rest /= kControlledLevels) s.levels[size_t(g)] = uint8_t(rest % kControlledLevels);
+            out.push_back(s);
+          }
+  return out;
+}
+
+ControlProfile twoGroups() { return ControlProfile::generic({"rest", "floor"}); }
+
+BudgetControllerParams paramsFor(double budget) {
+  BudgetControllerParams p;
+  p.budgetMs = budget;
+  p.foveationAvailable = true;
+  return p;
+}
+
+const FoveationMask kMask;  // never rendered: the controller only hands its address on
+
+TEST(BudgetController, HoldsTheBudgetThroughViewsThatCostThreeTimesIt) {
+  for (double budget : {kFrameMs, 5.5}) {
+    BudgetController c(twoGroups(), paramsFor(budget), RenderOptions(), &kMask);
+    // At the best setting the base view costs about the budget's 2.3x (11.1 ms) or 4.7x (5.5 ms); the
+    // heavy view three times the base.
+    const std::vector<TraceFrame> trace = walkTrace(2700, 900, 1800, 3.0, 45, 0.04, 7);
+    const double bestMs = frameCosts(c, c.best(), trace[0]).total();
+    EXPECT_GT(bestMs, 2.0 * budget);
+    const SimRun run = simulate(c, trace);
+    EXPECT_LE(run.p99(), budget) << "budget " << budget;
+    EXPECT_LE(run.over(budget), 0.005) << "budget " << budget;
+    EXPECT_GT(run.raises, 0) << "it must climb back when the heavy view is left";
+  }
+}
+
+TEST(BudgetController, LosesLessQualityThanAnyFixedSettingThatMeetsTheBudget) {
+  const std::vector<TraceFrame> trace = walkTrace(2700, 900, 1800, 3.0, 45, 0.04, 11);
+  for (double budget : {kFrameMs, 5.5}) {
+    BudgetController c(twoGroups(), paramsFor(budget), RenderOptions(), &kMask);
+    const SimRun controlled = simulate(c, trace);
+    BudgetController model(twoGroups(), paramsFor(budget), RenderOptions(), &kMask);
+    int meeting = 0;
+    double bestFixed = 1e30;
+    for (const ControlSetting& s : everySetting(model.profile(), true)) {
+      const SimRun fixed = simulateFixed(model, s, trace);
+      if (fixed.p99() > budget) continue;
+      ++meeting;
+      bestFixed = std::min(bestFixed, fixed.meanError());
+    }
+    ASSERT_GT(meeting, 0);
+    EXPECT_LT(controlled.meanError(), bestFixed) << "budget " << budget << ": " << meeting << " fixed settings meet it";
+  }
+}
+
+TEST(BudgetController, DoesNotOscillateOnASteadyView) {
+  BudgetController c(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const std::vector<TraceFrame> trace = walkTrace(3000, 1 << 30, 1 << 30, 1.0, 1, 0.03, 3);
+  const SimRun run = simulate(c, trace);
+  // It settles within the first second; afterwards the noise (+-3%) must not move it.
+  int changesLater = 0;
+  BudgetController again(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  for (size_t f = 0; f < trace.size(); ++f) {
+    const ControlDecision d = again.decide(double(f) * kFrameMs);
+    if (f > 180 && std::string(d.change) != "hold") ++changesLater;
+    again.observe(frameCosts(again, d.setting, trace[f]));
+  }
+  EXPECT_LE(changesLater, 2);
+  EXPECT_LE(run.p99(), kFrameMs);
+}
+
+TEST(BudgetController, RaisesNoFasterThanItsRate) {
+  BudgetController c(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  // Very heavy at first (10x), then a long light stretch: it climbs a few steps at a time.
+  const std::vector<TraceFrame> trace = walkTrace(2000, 0, 200, 10.0, 1, 0.02, 5);
+  const SimRun run = simulate(c, trace);
+  ASSERT_GE(run.raises, 2);
+  EXPECT_LE(run.p99(), kFrameMs);
+  const double rate = c.params().maxRaisesPerSecond;
+  for (size_t i = 1; i < run.raiseTimes.size(); ++i)
+    EXPECT_GE(run.raiseTimes[i] - run.raiseTimes[i - 1], 1000.0 / rate - 1e-9);
+}
+
+TEST(BudgetController, PredictsOtherSettingsFromOneMeasuredFrame) {
+  BudgetController c(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  TraceFrame f = walkTrace(1, 1 << 30, 1 << 30, 1.0, 1, 0.0, 1)[0];
+  // The first frame probes without the denoiser: its cost per iteration is the profile's until measured.
+  f.units.denoiseMs = c.profile().denoiseMsPerIteration;
+  const ControlDecision d = c.decide(0);
+  EXPECT_STREQ(d.change, "start");
+  EXPECT_EQ(d.setting.photons, 0);
+  c.observe(frameCosts(c, d.setting, f));
+  for (const ControlSetting& s : everySetting(c.profile(), true))
+    ASSERT_NEAR(c.predictMs(s), frameCosts(c, s, f).total(), 1e-9);
+}
+
+TEST(BudgetController, OptionsCarryTheSetting) {
+  RenderOptions base;
+  base.gather.density.radius = 0.1f;
+  BudgetController c(twoGroups(), paramsFor(kFrameMs), base, &kMask);
+  ControlSetting s = c.best();
+  s.photons = 2, s.radius = 0, s.denoise = 0, s.foveated = true;
+  s.levels[1] = uint8_t(EffectLevel::Reflections);
+  RenderOptions o = c.optionsFor(s);
+  EXPECT_EQ(o.photonsX, c.profile().photonSides[2]);
+  EXPECT_EQ(o.photonsY, c.profile().photonSides[2]);
+  EXPECT_FLOAT_EQ(o.gather.density.radius, 0.1f * c.profile().radiusScales[0]);
+  EXPECT_FALSE(o.denoise.enabled);
+  EXPECT_EQ(o.foveation.mask, &kMask);
+  EXPECT_EQ(o.gather.groupEffects[0], uint8_t(EffectLevel::Gi));
+  EXPECT_EQ(o.gather.groupEffects[1], uint8_t(EffectLevel::Reflections));
+  EXPECT_EQ(o.gather.groupEffects[2], kOwnEffectLevel);
+  // Nothing at gi: nothing gathers photons, the fewest are traced.
+  s.levels[0] = s.levels[1] = uint8_t(EffectLevel::Shadows);
+  s.denoise = 2;
+  o = c.optionsFor(s);
+  EXPECT_EQ(o.photonsX, c.profile().photonSides.front());
+  EXPECT_TRUE(o.denoise.enabled);
+  EXPECT_EQ(o.denoise.params.iterations, c.profile().denoiseIterations[2]);
+  EXPECT_EQ(c.scaleOf(s).densityMs, 0.0);
+  // Options asking for less than gi cap the group.
+  base.gather.groupEffects[1] = uint8_t(EffectLevel::Shadows);
+  BudgetController capped(twoGroups(), paramsFor(kFrameMs), base, &kMask);
+  EXPECT_EQ(capped.best().levels[1], uint8_t(EffectLevel::Shadows));
+  EXPECT_EQ(capped.best().levels[0], uint8_t(EffectLevel::Gi));
+}
+
+TEST(BudgetController, ProfilesRoundTripAndBadOnesAreRefused) {
+  ControlProfile p = twoGroups();
+  p.scene = "test";
+  p.levelError[1][0] = 0.125;
+  p.levelRayCost[1][1] = -0.25;
+  const std::string path = ::testing::TempDir() + "/profile.json";
+  {
+    std::ofstream out(path);
+    out << p.toJson().dump(2);
+  }
+  const ControlProfile q = ControlProfile::load(path, {"rest", "floor"});
+  EXPECT_EQ(q.toJson(), p.toJson());
+  EXPECT_THROW(ControlProfile::load(path, {"rest", "floor", "windows"}), Error);  // a group it was not calibrated for
+  EXPECT_THROW(ControlProfile::load(path + ".missing", {"rest"}), Error);
+  auto refused = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    try {
+      ControlProfile::load(path, {"rest", "floor"});
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused("{not json"));
+  EXPECT_TRUE(refused("[1, 2]"));
+  nlohmann::json j = p.toJson();
+  j["photon_sides"] = {512, 256, 1024, 128, 181, 362, 724};
+  EXPECT_TRUE(refused(j.dump()));
+  j = p.toJson();
+  j["error"]["photons"] = {0.1};
+  EXPECT_TRUE(refused(j.dump()));
+  j = p.toJson();
+  j["error"]["groups"]["floor"]["sparkle"] = 1.0;
+  EXPECT_TRUE(refused(j.dump()));
+  j = p.toJson();
+  j["cost"]["foveated_samples"] = 0.0;
+  EXPECT_TRUE(refused(j.dump()));
+  EXPECT_THROW(BudgetController(twoGroups(), paramsFor(-1.0), RenderOptions(), &kMask), Error);
+  EXPECT_THROW(BudgetController(twoGroups(), paramsFor(std::nan("")), RenderOptions(), &kMask), Error);
+}
+
+TEST(BudgetController, LogsEveryFrame) {
+  BudgetController c(twoGroups(), paramsFor(5.5), RenderOptions(), &kMask);
+  const std::vector<TraceFrame> trace = walkTrace(300, 100, 200, 3.0, 20, 0.02, 9);
+  ControlLog log;
+  for (size_t f = 0; f < trace.size(); ++f) {
+    const ControlDecision d = c.decide(double(f) * kFrameMs);
+    const ControlCosts costs = frameCosts(c, d.setting, trace[f]);
+    log.add(d, costs.total(), costs);
+    c.observe(costs);
+  }
+  const nlohmann::json j = log.toJson(c);
+  ASSERT_EQ(j["frames"].size(), trace.size());
+  EXPECT_EQ(j["budget_ms"], 5.5);
+  EXPECT_EQ(j["frames_over_budget"].get<size_t>(), log.framesOver(5.5));
+  EXPECT_GT(j["changes"].get<size_t>(), 0u);
+  EXPECT_EQ(j["frames"][0]["change"], "start");
+  EXPECT_TRUE(j["frames"][150]["setting"]["levels"].contains("floor"));
+}
+
+}  // namespace
+}  // namespace pvr
