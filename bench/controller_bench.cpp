@@ -58,14 +58,15 @@ double frameError(const FrameResult& f, const SampledView& v) {
 }
 
 // Renders the walk: `choose` gives each frame's options (and sees its measured time after).
+// `stride` > 1: every stride-th frame only (the sampled views' frames are among them).
 template <class Choose, class Observe>
 Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFrame>& trajectory,
-          const std::vector<SampledView>& views, Choose choose, Observe observe) {
+          const std::vector<SampledView>& views, Choose choose, Observe observe, int stride = 1) {
   Walk w;
   renderer.resetHistory();
   size_t nextView = 0;
   const auto start = Clock::now();
-  for (size_t f = 0; f < trajectory.size(); ++f) {
+  for (size_t f = 0; f < trajectory.size(); f += size_t(stride)) {
     rig.head = trajectory[f].head;
     RenderOptions o = choose(msSince(start));
     std::copy(&trajectory[f].gaze[0][0], &trajectory[f].gaze[0][0] + 4, &o.foveation.gaze[0][0]);
@@ -94,6 +95,9 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
   if (args.referencePasses < 2 || args.referencePasses > kMaxReferencePasses)
     throw Error("--reference-passes must be between 2 and " + std::to_string(kMaxReferencePasses));
   if (args.errorEvery < 1) throw Error("--error-every must be at least 1");
+  if (args.fixedStride < 1 || args.errorEvery % args.fixedStride != 0)
+    throw Error("--fixed-stride must be at least 1 and divide --error-every");
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each row as it is measured (a long suite may be cut short)
   std::vector<double> budgets;
   for (const std::string& b : splitList(args.budgets)) {
     char* end = nullptr;
@@ -104,9 +108,9 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
   }
   std::printf("\nThe budget controller on walks through scenes: frame time (host wall time of the stereo frame, images "
               "left on the device) mean / p50 / p99 and frames over the budget; error: mean relMSE of both eyes against "
-              "converged references (%d passes of 1024x1024 photons) of every %dth frame's view. Fixed settings: each "
+              "references (%d progressive passes of 1024x1024 photons) of every %dth frame's view; fixed settings render every %dth frame. Fixed settings: each "
               "setting the controller spent at least 2 %% of a walk in, and uniform ones.\n\n",
-              args.referencePasses, args.errorEvery);
+              args.referencePasses, args.errorEvery, args.fixedStride);
   for (const std::string& item : splitList(args.walks)) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos) throw Error("--walks: '" + item + "' is not SCENE=TRAJECTORY");
@@ -144,13 +148,13 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
       ro.photonsX = ro.photonsY = 1024;
       ro.gather.punctualShadowRays = 0;
       ro.gather.seed = 0x5eed + uint32_t(f);
-      ro.map = PhotonMapKind::KdTree;
       ReferenceSettings settings;
       settings.boxFilter = false;
       ProgressiveReference reference(*renderer, vr, ro, settings);
       for (int i = 0; i < args.referencePasses; ++i) reference.addPass();
       views.push_back({int(f), {reference.image(Eye::Left), reference.image(Eye::Right)}});
     }
+    std::printf("| %s | references: %zu views |\n", scene.name.c_str(), views.size());
     std::printf("| %s | %zu frames, %dx%d per eye, radius %g, profile %s, %zu reference views |\n", scene.name.c_str(),
                 trajectory.size(), rig.width, rig.height, base.gather.density.radius,
                 calibrated ? profilePath.c_str() : "generic (no calibrated profile found)", views.size());
@@ -177,11 +181,11 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
                     });
       for (const auto& [frame, error] : w.error) log.entries()[size_t(frame)].measuredError = error;
       for (const ControlLogEntry& e : log.entries()) ++w.settingFrames[BudgetController::toJson(e.decision.setting, profile).dump()];
-      // The settings it spent most time in (at most 4, each at least 3 % of the walk) are run fixed.
+      // The settings it spent most time in (at most 3, each at least 3 % of the walk) are run fixed.
       std::vector<std::pair<int, std::string>> used;
       for (const auto& [key, frames] : w.settingFrames) used.push_back({frames, key});
       std::sort(used.rbegin(), used.rend());
-      for (size_t u = 0; u < used.size() && u < 4; ++u)
+      for (size_t u = 0; u < used.size() && u < 3; ++u)
         if (used[u].first >= int(0.03 * double(trajectory.size())))
           for (const ControlLogEntry& e : log.entries())
             if (BudgetController::toJson(e.decision.setting, profile).dump() == used[u].second) {
@@ -189,6 +193,8 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
               break;
             }
       w.name = "controller";
+      std::printf("| %s | walked: controller at %.2f ms, p99 %.2f ms, %zu changes |\n", scene.name.c_str(), budget, w.p99(),
+                  log.changes());
       w.log = std::move(log);
       controlled.push_back(std::move(w));
       // Its decisions, for the plot.
@@ -197,7 +203,7 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
                       {"profile", calibrated ? profilePath : "generic"}, {"log", controlled.back().log.toJson(controller)}});
     }
     // The uniform ladder: everything at one level, the controller's best photons, radius and denoiser.
-    for (int level = 0; level < kControlledLevels; ++level) {
+    for (int level = int(EffectLevel::Shadows); level < kControlledLevels; ++level) {  // raster: unshadowed suns
       ControlSetting s = model.best();
       for (size_t g = 0; g < profile.groups.size(); ++g) s.levels[g] = uint8_t(std::min<int>(level, s.levels[g]));
       candidates[BudgetController::toJson(s, profile).dump()] = s;
@@ -210,8 +216,10 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
     std::vector<std::pair<std::string, Walk>> fixed;
     for (const auto& [key, setting] : candidates) {
       const RenderOptions o = model.optionsFor(setting);
-      Walk w = walk(*renderer, rig, trajectory, views, [&](double) { return o; }, [](const StageTimings&, double) {});
+      Walk w = walk(*renderer, rig, trajectory, views, [&](double) { return o; }, [](const StageTimings&, double) {},
+                    args.fixedStride);
       w.name = key;
+      std::printf("| %s | walked: fixed %s, p99 %.2f ms |\n", scene.name.c_str(), key.c_str(), w.p99());
       fixed.emplace_back(key, std::move(w));
     }
     for (size_t b = 0; b < budgets.size(); ++b) {
@@ -248,7 +256,8 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
       nlohmann::json frames = w.ms, errors = nlohmann::json::array();
       for (const auto& [frame, error] : w.error) errors.push_back({frame, error});
       json.push_back({{"suite", "controller"}, {"scene", scene.name}, {"policy", "fixed"}, {"setting", nlohmann::json::parse(name)},
-                      {"frame", latencyStats(w.ms)}, {"mean_rel_mse", w.meanError()}, {"frame_ms", frames}, {"errors", errors}});
+                      {"frame", latencyStats(w.ms)}, {"mean_rel_mse", w.meanError()}, {"frame_ms", frames},
+                      {"frame_stride", args.fixedStride}, {"errors", errors}});
     }
   }
   return failures;

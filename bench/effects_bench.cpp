@@ -24,7 +24,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Measured {
-  LatencyStats frame, rays, density, primary;
+  LatencyStats frame, rays, density, primary, photons;
   double relMse[2] = {-1, -1};  ///< per eye against the reference (-1: eye not rendered)
   double shadedFraction = 1.0;  ///< shaded samples over pixels (foveation)
   double denoiseMs = 0;
@@ -34,7 +34,7 @@ struct Measured {
 Measured measure(FrameRenderer& renderer, const StereoRig& rig, const RenderOptions& o, int warmup, int frames,
                  const Image reference[2], bool resetEachFrame) {
   for (int i = 0; i < warmup; ++i) renderer.render(rig, o, false);
-  std::vector<double> frame, rays, density, primary, denoise;
+  std::vector<double> frame, rays, density, primary, denoise, photons;
   for (int i = 0; i < frames; ++i) {
     if (resetEachFrame) renderer.resetHistory();
     const auto start = Clock::now();
@@ -45,10 +45,12 @@ Measured measure(FrameRenderer& renderer, const StereoRig& rig, const RenderOpti
     density.push_back(t.densityMs[0] + t.densityMs[1]);
     primary.push_back(t.primaryMs);
     denoise.push_back(t.denoiseMs[0] + t.denoiseMs[1]);
+    photons.push_back(t.photonTraceMs + t.mapBuildMs);
   }
   Measured m;
   m.frame = latencyStats(frame), m.rays = latencyStats(rays), m.density = latencyStats(density);
   m.primary = latencyStats(primary);
+  m.photons = latencyStats(photons);
   m.denoiseMs = latencyStats(denoise).mean;
   if (resetEachFrame) renderer.resetHistory();
   const FrameResult last = renderer.render(rig, o, true);
@@ -89,11 +91,27 @@ ControlProfile calibrate(FrameRenderer& renderer, const Scene& scene, const Ster
   p.topError = topError;
   std::printf("| %s | calibration: best setting %s, relMSE %.4f, %.2f ms |\n", scene.name.c_str(),
               BudgetController::toJson(top, p).dump().c_str(), topError, best.frame.mean);
+  // Each photon step's error, and its photon and density times for the costs' affine fits.
+  std::vector<double> counts, photonMs, densityMs;
   for (size_t i = 0; i < p.photonSides.size(); ++i) {
     ControlSetting s = top;
     s.photons = int(i);
-    p.photonError[i] = int(i) == top.photons ? 0.0 : meanError(run(s)) - topError;
+    const Measured m = int(i) == top.photons ? best : run(s);
+    p.photonError[i] = int(i) == top.photons ? 0.0 : meanError(m) - topError;
+    counts.push_back(double(p.photonSides[i]) * p.photonSides[i]);
+    photonMs.push_back(m.photons.mean), densityMs.push_back(m.density.mean);
   }
+  // The fixed share of an affine fit a + b N, as a share of its value at the top count.
+  auto fixedShare = [&](const std::vector<double>& y) {
+    const double n = double(counts.size());
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (size_t i = 0; i < counts.size(); ++i) sx += counts[i], sy += y[i], sxx += counts[i] * counts[i], sxy += counts[i] * y[i];
+    const double b = (n * sxy - sx * sy) / std::max(n * sxx - sx * sx, 1e-30), a = (sy - b * sx) / n;
+    const double top = a + b * counts.back();
+    return top > 0 ? std::clamp(a / top, 0.0, 0.95) : 0.1;
+  };
+  p.photonFixedShare = fixedShare(photonMs);
+  p.densityFixedShare = fixedShare(densityMs);
   for (size_t i = 0; i < p.radiusScales.size(); ++i) {
     ControlSetting s = top;
     s.radius = int(i);
@@ -119,7 +137,10 @@ ControlProfile calibrate(FrameRenderer& renderer, const Scene& scene, const Ster
     s.foveated = true;
     const Measured m = run(s);
     p.foveatedError = meanError(m) - topError;
-    p.foveatedSamples = std::clamp(m.shadedFraction, 0.01, 1.0);
+    // The eye pass's time, not its sample count: the foveated pass does not shrink with its samples
+    // (on the H200's Sponza 2.6 % of the samples took 8 % of the time).
+    const double full = best.rays.mean + best.density.mean, foveated = m.rays.mean + m.density.mean;
+    p.foveatedSamples = full > 0 ? std::clamp(foveated / full, 0.01, 1.0) : std::clamp(m.shadedFraction, 0.01, 1.0);
   }
   const double topRays = std::max(best.rays.mean, 1e-6), topDensity = std::max(best.density.mean, 1e-6);
   double shares = 0;
@@ -144,6 +165,7 @@ ControlProfile calibrate(FrameRenderer& renderer, const Scene& scene, const Ster
 
 int runEffects(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json) {
   int failures = 0;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each row as it is measured (a long suite may be cut short)
   if (args.referencePasses < 2 || args.referencePasses > kMaxReferencePasses)
     throw Error("--reference-passes must be between 2 and " + std::to_string(kMaxReferencePasses));
   std::printf("\nEffect levels (Ray-VR's section V): full shading, hash grid, 512x512 photons, hybrid kernel, %d timed frames "

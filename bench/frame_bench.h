@@ -40,6 +40,7 @@ struct FrameBenchArgs {
   std::string budgets = "11.1,5.5";  ///< controller suite: frame budgets, ms
   std::string profiles;       ///< controller suite: read PREFIX_<scene>.json where it exists (else the generic model)
   int errorEvery = 45;        ///< controller suite: a reference view every this many frames
+  int fixedStride = 1;        ///< controller suite: fixed settings render every this many frames of the walk
   int frames = 300;  ///< timed frames per cell (with fewer than 100, p99 is the max)
   int warmup = 10;
   int k = 32;

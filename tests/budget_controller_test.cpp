@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include "pvr/control/budget_controller.h"
 #include "pvr/foveation/mask.h"
@@ -37,9 +38,9 @@ std::vector<TraceFrame> walkTrace(int frames, int heavyFrom, int heavyTo, double
     if (f >= heavyTo) t = std::max(0.0, 1.0 - double(f - heavyTo + 1) / ramp);
     const double k = 1.0 + (heavy - 1.0) * t;
     TraceFrame tf;
-    tf.units.photonMs = 2.0;  // the photons cost what they cost wherever the head looks
-    tf.units.densityMs = 3.0 * k;
-    tf.units.rayMs = 4.0 * k;
+    tf.units.photonMs = 12.0;  // at the top photon count; they cost what they cost wherever the head looks
+    tf.units.densityMs = 4.0 * k;
+    tf.units.rayMs = 6.0 * k;
     tf.units.denoiseMs = 0.3;
     tf.units.restMs = 0.5;
     tf.noise = 1.0 + noise * (2.0 * rng.uniform() - 1.0);
@@ -81,7 +82,7 @@ SimRun simulate(BudgetController& c, const std::vector<TraceFrame>& trace) {
     const double now = double(f) * kFrameMs;
     const ControlDecision d = c.decide(now);
     if (std::string(d.change) == "raise") ++run.raises, run.raiseTimes.push_back(now);
-    if (std::string(d.change) == "lower") ++run.lowers;
+    if (std::string(d.change) == "lower" || std::string(d.change) == "replan") ++run.lowers;
     const ControlCosts costs = frameCosts(c, d.setting, trace[f]);
     run.ms.push_back(costs.total());
     run.error.push_back(c.predictError(d.setting));
@@ -175,6 +176,100 @@ TEST(BudgetController, DoesNotOscillateOnASteadyView) {
   EXPECT_LE(run.p99(), kFrameMs);
 }
 
+// A renderer's first frame pays for its allocations (33 ms against 3 on the H200's Sponza walk):
+// the probe's first measurement is not counted, so the controller settles as if it had not been.
+TEST(BudgetController, IgnoresTheFirstFramesAllocations) {
+  const std::vector<TraceFrame> steady = walkTrace(400, 1 << 30, 1 << 30, 1.0, 1, 0.0, 2);
+  std::vector<TraceFrame> cold = steady;
+  cold[0].noise = 10.0;
+  BudgetController a(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  BudgetController b(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const SimRun warmRun = simulate(a, steady), coldRun = simulate(b, cold);
+  EXPECT_EQ(a.current(), b.current());
+  for (size_t f = 2; f < steady.size(); ++f) ASSERT_EQ(warmRun.ms[f], coldRun.ms[f]) << "frame " << f;
+  EXPECT_EQ(coldRun.lowers, warmRun.lowers);
+}
+
+// A recorded walk: each frame's measured costs divided by its setting's scales are the view's unit
+// costs (a term the setting did not run is carried from the nearest frame that ran it).
+std::vector<TraceFrame> recordedTrace(const BudgetController& c, const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  std::vector<TraceFrame> trace;
+  std::vector<std::array<bool, 5>> known;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    ControlSetting s;
+    int fov = 0, levels[3] = {0, 0, 0};
+    ControlCosts ms;
+    fields >> s.photons >> s.radius >> s.denoise >> fov >> levels[0] >> levels[1] >> levels[2] >> ms.photonMs >> ms.densityMs >>
+        ms.rayMs >> ms.denoiseMs >> ms.restMs;
+    EXPECT_TRUE(bool(fields)) << line;
+    s.foveated = fov != 0;
+    for (int g = 0; g < 3; ++g) s.levels[size_t(g)] = uint8_t(levels[g]);
+    const ControlCosts scale = c.scaleOf(s);
+    TraceFrame f;
+    double* unit[5] = {&f.units.photonMs, &f.units.densityMs, &f.units.rayMs, &f.units.denoiseMs, &f.units.restMs};
+    const double measured[5] = {ms.photonMs, ms.densityMs, ms.rayMs, ms.denoiseMs, ms.restMs};
+    const double scales[5] = {scale.photonMs, scale.densityMs, scale.rayMs, scale.denoiseMs, scale.restMs};
+    std::array<bool, 5> k{};
+    for (int t = 0; t < 5; ++t) k[size_t(t)] = scales[t] > 0, *unit[t] = scales[t] > 0 ? measured[t] / scales[t] : 0.0;
+    trace.push_back(f);
+    known.push_back(k);
+  }
+  for (int t = 0; t < 5; ++t) {  // carry each term forward, then backward, over the frames that lack it
+    auto term = [t](TraceFrame& f) -> double& {
+      double* unit[5] = {&f.units.photonMs, &f.units.densityMs, &f.units.rayMs, &f.units.denoiseMs, &f.units.restMs};
+      return *unit[t];
+    };
+    std::vector<bool> have(trace.size());
+    for (size_t i = 0; i < trace.size(); ++i) have[i] = known[i][size_t(t)];
+    for (size_t i = 1; i < trace.size(); ++i)
+      if (!have[i] && have[i - 1]) term(trace[i]) = term(trace[i - 1]), have[i] = true;
+    for (size_t i = trace.size() - 1; i-- > 0;)
+      if (!have[i] && have[i + 1]) term(trace[i]) = term(trace[i + 1]), have[i] = true;
+  }
+  return trace;
+}
+
+// The H200's Sponza walk (tests/data/sponza_walk_h200.trace, its calibrated profile beside it)
+// replayed at 11.1 and 5.5 ms: p99 under the budget, at most 0.5 % of frames over it, an error
+// near the best fixed setting's in hindsight; and the walk's best setting costs several budgets.
+TEST(BudgetController, HoldsTheBudgetOnTheRecordedSponzaWalk) {
+  const std::string data = PVR_TEST_DATA;
+  const ControlProfile profile = ControlProfile::load(data + "/sponza_h200.profile.json", {"rest", "floor", "decorations"});
+  for (double budget : {kFrameMs, 5.5}) {
+    BudgetController c(profile, paramsFor(budget), RenderOptions(), &kMask);
+    const std::vector<TraceFrame> trace = recordedTrace(c, data + "/sponza_walk_h200.trace");
+    ASSERT_EQ(trace.size(), 2700u);
+    double worstBest = 0;
+    for (size_t f = 1; f < trace.size(); ++f) worstBest = std::max(worstBest, frameCosts(c, c.best(), trace[f]).total());
+    EXPECT_GT(worstBest, 2.0 * budget) << "the best setting must not fit: there is nothing to control otherwise";
+    const SimRun run = simulate(c, trace);
+    EXPECT_LE(run.p99(), budget) << budget;
+    EXPECT_LE(run.over(budget), 0.005) << budget;
+    BudgetController model(profile, paramsFor(budget), RenderOptions(), &kMask);
+    double bestFixed = 1e30;
+    ControlSetting bestFixedSetting;
+    for (const ControlSetting& s : everySetting(profile, true)) {
+      const SimRun fixed = simulateFixed(model, s, trace);
+      if (fixed.p99() <= budget && fixed.over(budget) <= 0.005 && fixed.meanError() < bestFixed)
+        bestFixed = fixed.meanError(), bestFixedSetting = s;
+    }
+    std::printf("controller ends at %s (%.2f ms); best fixed %s\n", BudgetController::toJson(c.current(), profile).dump().c_str(),
+                c.predictMs(c.current()), BudgetController::toJson(bestFixedSetting, profile).dump().c_str());
+    // On this walk the cost is nearly constant after its first seconds, so the best fixed setting,
+    // chosen in hindsight from the whole walk at the budget's edge, is close to the controller's
+    // final one plus what its safety margin leaves unused: the controller must stay within 20 %
+    // of it (measured: 5 % above at 11.1 ms, 0.4 % above at 5.5 ms; docs/ray-vr.md).
+    EXPECT_LT(run.meanError(), 1.2 * bestFixed) << budget;
+    std::printf("budget %.2f ms: best setting up to %.1f ms (%.1fx), controller p99 %.2f ms, %.2f %% over, mean "
+                "predicted relMSE %.4f against the best fixed setting's %.4f\n",
+                budget, worstBest, worstBest / budget, run.p99(), 100.0 * run.over(budget), run.meanError(), bestFixed);
+  }
+}
+
 TEST(BudgetController, RaisesNoFasterThanItsRate) {
   BudgetController c(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
   // Very heavy at first (10x), then a long light stretch: it climbs a few steps at a time.
@@ -223,7 +318,7 @@ TEST(BudgetController, OptionsCarryTheSetting) {
   EXPECT_EQ(o.photonsX, c.profile().photonSides.front());
   EXPECT_TRUE(o.denoise.enabled);
   EXPECT_EQ(o.denoise.params.iterations, c.profile().denoiseIterations[2]);
-  EXPECT_EQ(c.scaleOf(s).densityMs, 0.0);
+  EXPECT_DOUBLE_EQ(c.scaleOf(s).densityMs, c.profile().densityFixedShare) << "only the density stage's fixed part runs";
   // Options asking for less than gi cap the group.
   base.gather.groupEffects[1] = uint8_t(EffectLevel::Shadows);
   BudgetController capped(twoGroups(), paramsFor(kFrameMs), base, &kMask);

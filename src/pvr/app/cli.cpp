@@ -810,6 +810,9 @@ int runCli(int argc, char** argv) {
   bench->add_option("--profiles", fa.profiles, "Controller suite: use PREFIX_<scene>.json (from --profile-out) where it exists");
   bench->add_option("--error-every", fa.errorEvery, "Controller suite: a converged reference of every Nth frame's view")
       ->capture_default_str();
+  bench->add_option("--fixed-stride", fa.fixedStride,
+                    "Controller suite: the fixed settings render every Nth frame of the walk (N divides --error-every)")
+      ->capture_default_str();
   bench->add_option("--photons", ba.photons, "Comma-separated photon grids (maps suite)")->capture_default_str();
   bench->add_option("--radii", ba.radii, "Comma-separated search radii (maps suite)")->capture_default_str();
   bench->add_option("--queries", ba.queries, "Query points: eye hit points on a WxH grid of the left eye (maps suite)")

@@ -13,7 +13,6 @@
 namespace pvr {
 namespace {
 
-constexpr double kReferencePhotons = 512.0 * 512.0;  // the unit of the photon terms
 constexpr double kMinShare = 0.02;                   // a term never predicted to vanish
 constexpr size_t kMaxExhaustive = 50000;             // settings searched one by one when lowering
 
@@ -118,6 +117,8 @@ void ControlProfile::validate() const {
   check(topError, "the top error");
   check(foveatedError, "the foveated error");
   if (!(foveatedSamples > 0.0 && foveatedSamples <= 1.0)) throw Error("foveated samples must be within (0, 1]");
+  if (!(photonFixedShare >= 0.0 && photonFixedShare < 1.0) || !(densityFixedShare >= 0.0 && densityFixedShare < 1.0))
+    throw Error("the fixed shares of the photon and density costs must be within [0, 1)");
   if (!(denoiseMsPerIteration >= 0.0) || !finite(denoiseMsPerIteration)) throw Error("denoise ms per iteration must be >= 0");
   for (double v : photonError) check(v, "photon errors");
   for (double v : radiusError) check(v, "radius errors");
@@ -150,6 +151,8 @@ ControlProfile ControlProfile::load(const std::string& path, const std::vector<s
     p.foveatedError = err.at("foveated").get<double>();
     p.foveatedSamples = cost.at("foveated_samples").get<double>();
     p.denoiseMsPerIteration = cost.value("denoise_ms_per_iteration", p.denoiseMsPerIteration);
+    p.photonFixedShare = cost.value("photon_fixed_share", p.photonFixedShare);
+    p.densityFixedShare = cost.value("density_fixed_share", p.densityFixedShare);
     p.groups = sceneGroups;
     p.levelError.clear(), p.levelRayCost.clear(), p.densityShare.clear();
     for (const std::string& g : sceneGroups) {
@@ -182,7 +185,8 @@ nlohmann::json ControlProfile::toJson() const {
           {"error", {{"top", topError}, {"photons", photonError}, {"radius", radiusError}, {"denoise", denoiseError},
                      {"foveated", foveatedError}, {"groups", errGroups}}},
           {"cost", {{"groups", costGroups}, {"density_share", shares}, {"foveated_samples", foveatedSamples},
-                    {"denoise_ms_per_iteration", denoiseMsPerIteration}}}};
+                    {"denoise_ms_per_iteration", denoiseMsPerIteration}, {"photon_fixed_share", photonFixedShare},
+                    {"density_fixed_share", densityFixedShare}}}};
 }
 
 BudgetController::BudgetController(const ControlProfile& profile, const BudgetControllerParams& params,
@@ -191,7 +195,9 @@ BudgetController::BudgetController(const ControlProfile& profile, const BudgetCo
   profile_.validate();
   if (!(params.budgetMs > 0.0) || !finite(params.budgetMs) || params.budgetMs > 10000.0)
     throw Error("the frame budget must be a positive number of milliseconds (at most 10000)");
-  if (!(params.margin >= 0.0 && params.margin < 0.9) || !(params.raiseHeadroom >= 0.0 && params.margin + params.raiseHeadroom < 0.95))
+  if (!(params.margin >= 0.0 && params.margin <= params.maxMargin && params.maxMargin < 0.9) ||
+      !(params.startMargin >= 0.0 && params.startMargin < 0.9) ||
+      !(params.raiseHeadroom >= 0.0 && params.maxMargin + params.raiseHeadroom < 0.95))
     throw Error("the controller's margins must leave part of the budget");
   if (params.window < 1 || params.holdFrames < 0 || !(params.maxRaisesPerSecond > 0.0))
     throw Error("the controller's window, hold and raise rate must be positive");
@@ -241,7 +247,7 @@ ControlCosts BudgetController::scaleOf(const ControlSetting& s) const {
   ControlCosts scale;
   // Without a group at gi nothing gathers photons: the fewest are traced (optionsFor).
   const double side = hasGi(s) ? profile_.photonSides[size_t(s.photons)] : profile_.photonSides.front();
-  const double photons = side * side / kReferencePhotons;
+  const double photons = side * side / (double(profile_.photonSides.back()) * profile_.photonSides.back());  // of the top count
   const double r = profile_.radiusScales[size_t(s.radius)];
   const double samples = s.foveated ? profile_.foveatedSamples : 1.0;
   double giShare = 0, rays = 1.0;
@@ -250,8 +256,9 @@ ControlCosts BudgetController::scaleOf(const ControlSetting& s) const {
     if (level == int(EffectLevel::Gi)) giShare += profile_.densityShare[size_t(g)];
     rays += profile_.levelRayCost[size_t(g)][size_t(level)];
   }
-  scale.photonMs = photons;
-  scale.densityMs = photons * r * r * std::max(giShare, hasGi(s) ? kMinShare : 0.0) * samples;
+  const double fp = profile_.photonFixedShare, fd = profile_.densityFixedShare;
+  scale.photonMs = fp + (1.0 - fp) * photons;
+  scale.densityMs = fd + (1.0 - fd) * photons * r * r * std::max(giShare, hasGi(s) ? kMinShare : 0.0) * samples;
   scale.rayMs = std::max(rays, kMinShare) * samples;
   scale.denoiseMs = profile_.denoiseIterations[size_t(s.denoise)];
   scale.restMs = 1.0;
@@ -331,9 +338,12 @@ ControlDecision BudgetController::decide(double nowMs) {
     current_.denoise = 0;
     current_.foveated = params_.foveationAvailable;
     d.change = "start";
-  } else if (!settled_ && !units_.empty()) {
+  } else if (!settled_ && units_.size() < 2) {
+    d.change = "start";  // the probe again: a renderer's first frame pays for its allocations
+  } else if (!settled_) {
     settled_ = true;
-    const double raiseLimit = params_.budgetMs * (1.0 - params_.margin - params_.raiseHeadroom);
+    units_.erase(units_.begin());
+    const double raiseLimit = params_.budgetMs * (1.0 - margin() - params_.raiseHeadroom);
     ControlSetting chosen = current_;
     double chosenError = std::numeric_limits<double>::infinity();
     auto consider = [&](const ControlSetting& c) {
@@ -349,8 +359,8 @@ ControlDecision BudgetController::decide(double nowMs) {
     lastRaiseMs_ = nowMs;
     d.change = "start";
   } else if (!units_.empty()) {
-    const double limit = params_.budgetMs * (1.0 - params_.margin);
-    const double raiseLimit = params_.budgetMs * (1.0 - params_.margin - params_.raiseHeadroom);
+    const double limit = params_.budgetMs * (1.0 - margin());
+    const double raiseLimit = params_.budgetMs * (1.0 - margin() - params_.raiseHeadroom);
     const double predicted = predictMs(current_);
     if (predicted > limit) {
       // Lower at once, to the setting of least error that fits (the cheapest if none does).
@@ -386,8 +396,9 @@ ControlDecision BudgetController::decide(double nowMs) {
         consider(s);
       }
       if (!(chosen == current_)) {
+        // Over the limit it re-plans from every setting: the one that fits may be better elsewhere.
+        d.change = predictError(chosen) < predictError(current_) ? "replan" : "lower";
         current_ = chosen;
-        d.change = "lower";
       }
     } else {
       headroomFrames_ = predicted <= raiseLimit ? headroomFrames_ + 1 : 0;
@@ -420,10 +431,21 @@ ControlDecision BudgetController::decide(double nowMs) {
   d.setting = current_;
   d.predictedMs = predictMs(current_);
   d.predictedError = predictError(current_);
+  lastPredictedMs_ = d.predictedMs;
   return d;
 }
 
+double BudgetController::margin() const {
+  if (overruns_.size() < 90) return std::clamp(params_.startMargin, params_.margin, params_.maxMargin);
+  const double worst = *std::max_element(overruns_.begin(), overruns_.end());
+  return std::clamp(worst + 0.02, params_.margin, params_.maxMargin);
+}
+
 void BudgetController::observe(const ControlCosts& measured) {
+  if (lastPredictedMs_ > 0 && settled_) {
+    overruns_.push_back(measured.total() / lastPredictedMs_ - 1.0);
+    if (overruns_.size() > 90) overruns_.erase(overruns_.begin());
+  }
   const ControlCosts scale = scaleOf(current_);
   ControlCosts unit = units_.empty() ? ControlCosts{} : units_.back();
   if (units_.empty()) unit.denoiseMs = profile_.denoiseMsPerIteration;
@@ -463,7 +485,8 @@ size_t ControlLog::framesOver(double budgetMs) const {
 
 size_t ControlLog::changes() const {
   return size_t(std::count_if(entries_.begin(), entries_.end(), [](const ControlLogEntry& e) {
-    return std::string(e.decision.change) == "lower" || std::string(e.decision.change) == "raise";
+    const std::string c = e.decision.change;
+    return c == "lower" || c == "raise" || c == "replan";
   }));
 }
 
@@ -484,7 +507,8 @@ nlohmann::json ControlLog::toJson(const BudgetController& controller) const {
     frames.push_back(std::move(f));
   }
   return {{"budget_ms", budget},
-          {"margin", controller.params().margin},
+          {"margin_min", controller.params().margin},
+          {"margin_at_end", controller.currentMargin()},
           {"profile", controller.profile().scene},
           {"frame_ms", latencyStats(std::move(ms))},
           {"frames_over_budget", framesOver(budget)},

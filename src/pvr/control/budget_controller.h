@@ -13,7 +13,8 @@
 // compared on equal terms.
 // Quality model: each knob's added error (relMSE against the converged reference) measured alone
 // at a calibration view, summed (ControlProfile; `bench --suite effects --profile-out` makes one).
-// It starts by probing the view at the fewest photons, then takes the best setting that fits.
+// It starts by probing the view for two frames at the fewest photons (the first frame's
+// allocations are not counted), then takes the best setting that fits.
 // Hysteresis: the setting is lowered at once, as far as needed, when the predicted time of the
 // current one passes budget x (1 - margin); it is raised by at most two knob steps at a time (one
 // up, or one up and one down), only after the headroom has held for `holdFrames` frames, at most
@@ -58,11 +59,15 @@ struct ControlProfile {
   double foveatedError = 0.01;
   std::vector<std::array<double, kControlledLevels>> levelError;  ///< per group, per level (gi: 0)
   // Cost shapes: eye-ray time of each group's level relative to all at gi (whose eye rays are
-  // 1), the share of the density work each group's gather points do, the shaded samples of the
-  // foveated frame over the pixels.
+  // 1), the share of the density work each group's gather points do, the foveated eye pass's time
+  // over the full-resolution one's.
   std::vector<std::array<double, kControlledLevels>> levelRayCost;  ///< per group, per level: added to 1
   std::vector<double> densityShare;  ///< per group; the shares sum to 1
   double foveatedSamples = 0.25;
+  // What the photon pass (trace + build) and the density stage cost whatever the photon count
+  // (launches, the grid's clearing), as shares of their cost at the top count: each is affine in
+  // the photons, not proportional (on the H200's Sponza 128^2 photons took 0.66 ms, 724^2 3.8 ms).
+  double photonFixedShare = 0.1, densityFixedShare = 0.1;
   double denoiseMsPerIteration = 0.2;  ///< until a denoised frame has been measured
 
   // The generic model for a scene with these groups: variance ~ 1 / (photons x radius^2), bias ~
@@ -77,8 +82,11 @@ struct ControlProfile {
 
 struct BudgetControllerParams {
   double budgetMs = 1000.0 / 90.0;
-  double margin = 0.12;         ///< the predicted time must stay under budget x (1 - margin)
-  double raiseHeadroom = 0.06;  ///< raising needs the new setting under budget x (1 - margin - this)
+  // The predicted time must stay under budget x (1 - margin). The margin follows how far the
+  // frames of the last second ran over their predictions (+ 2 %), within [margin, maxMargin];
+  // startMargin until a second has been seen.
+  double margin = 0.04, maxMargin = 0.25, startMargin = 0.12;
+  double raiseHeadroom = 0.05;  ///< raising needs the new setting under budget x (1 - margin - this)
   int holdFrames = 10;          ///< frames of headroom before a raise
   double maxRaisesPerSecond = 4.0;
   double minGain = 0.03;        ///< a raise must lower the predicted error by this fraction
@@ -90,7 +98,7 @@ struct BudgetControllerParams {
 struct ControlDecision {
   ControlSetting setting;
   double predictedMs = 0, predictedError = 0;
-  const char* change = "hold";  ///< "hold" | "lower" | "raise" | "start"
+  const char* change = "hold";  ///< "hold" | "lower" | "raise" | "replan" (over the limit, to a better setting that fits) | "start"
 };
 
 // Per-frame measured stage times, in the terms of the cost model.
@@ -128,6 +136,7 @@ class BudgetController {
   const ControlSetting& current() const { return current_; }
   const ControlProfile& profile() const { return profile_; }
   const BudgetControllerParams& params() const { return params_; }
+  double currentMargin() const { return margin(); }
 
   static nlohmann::json toJson(const ControlSetting& s, const ControlProfile& profile);
 
@@ -143,6 +152,9 @@ class BudgetController {
   ControlSetting best_, current_;
   std::vector<ControlSetting> all_;  ///< every setting, for lowering
   std::vector<ControlCosts> units_;  ///< the last frames' unit costs (ring, newest last)
+  double margin() const;  ///< the margin now (BudgetControllerParams::margin)
+  std::vector<double> overruns_;   ///< the last second's measured / predicted - 1
+  double lastPredictedMs_ = 0;
   double densityPerRay_ = -1;      ///< the unit density cost over the unit eye-ray cost, when last measured
   int headroomFrames_ = 0;
   double lastRaiseMs_ = -1e30;

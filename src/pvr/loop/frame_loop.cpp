@@ -73,7 +73,7 @@ FrameStats FrameLoop::run(const FrameLoopOptions& options) {
       if (controller) control.add(*decision, record.cpuMs, ControlCosts::of(frame.timings, record.cpuMs));
     }
   }
-  if (controller) stats.setControl(controller, std::move(control));
+  if (controller) stats.setControl(control.toJson(*controller), control.summary(*controller));
   return stats;
 }
 

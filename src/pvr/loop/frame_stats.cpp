@@ -59,7 +59,7 @@ nlohmann::json FrameStats::toJson() const {
             {"right_eye_rays", stage([](const StageTimings& t) { return t.eyeRayMs[1]; })},
             {"left_eye", stage([](const StageTimings& t) { return t.eyeMs[0]; })},
             {"right_eye", stage([](const StageTimings& t) { return t.eyeMs[1]; })}}}};
-  if (controller_) out["controller"] = control_.toJson(*controller_);
+  if (!controlJson_.is_null()) out["controller"] = controlJson_;
   return out;
 }
 
@@ -79,7 +79,7 @@ std::string FrameStats::summary() const {
   row("hand-over to display", present());
   row("loop overhead", overhead());
   row("frame-to-frame", interval());
-  if (controller_) text += control_.summary(*controller_);
+  text += controlSummary_;
   return text;
 }
 

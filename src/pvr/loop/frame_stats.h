@@ -8,7 +8,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pvr/control/budget_controller.h"
 #include "pvr/pipeline/frame_result.h"
 #include "pvr/util/latency_stats.h"
 
@@ -31,8 +30,9 @@ class FrameStats {
  public:
   void add(const FrameRecord& record) { records_.push_back(record); }
   void addSkipped() { ++skipped_; }  ///< a frame the display did not want rendered
-  // A controlled loop's decisions (toJson's "controller" and the summary's last line).
-  void setControl(const BudgetController* controller, ControlLog log) { controller_ = controller, control_ = std::move(log); }
+  // A controlled loop's decisions (toJson's "controller" and the summary's last line), taken when
+  // the loop ends: the stats outlive the controller.
+  void setControl(nlohmann::json json, std::string summary) { controlJson_ = std::move(json), controlSummary_ = std::move(summary); }
   size_t frames() const { return records_.size(); }
   size_t skipped() const { return skipped_; }
   size_t missedDeadlines() const;
@@ -54,8 +54,8 @@ class FrameStats {
  private:
   std::vector<FrameRecord> records_;
   size_t skipped_ = 0;
-  const BudgetController* controller_ = nullptr;
-  ControlLog control_;
+  nlohmann::json controlJson_;  ///< null: no controller
+  std::string controlSummary_;
 };
 
 }  // namespace pvr
