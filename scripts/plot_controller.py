@@ -27,7 +27,7 @@ def plot_loop_stats(doc, out, title):
     ta.axhline(c["budget_ms"], color="k", ls="--", lw=1, label=f"budget {c['budget_ms']:g} ms")
     ta.set_ylim(0, 2.2 * c["budget_ms"])
     ta.set_ylabel("ms")
-    ta.set_title(title + f": p99 {c['frame_ms']['p99']:.2f} ms, {c['frames_over_budget']} of {len(frames)} frames over, "
+    ta.set_title(title + f"\np99 {c['frame_ms']['p99']:.2f} ms, {c['frames_over_budget']} of {len(frames)} frames over, "
                  f"{c['changes']} changes")
     ta.legend(fontsize=8, loc="upper right")
     ea.plot([f["predicted_error"] for f in frames], lw=1)

@@ -45,6 +45,21 @@ expect_render rasterfov "rasterfov_0000_left.png rasterfov_0004_right.png" --pri
 expect_render fovtaa "fovtaa_0000_left.png fovtaa_0004_right.png" --foveated --taa --taa-blend 0.2 --stereo gather \
   --trajectory "$data/gaze_pursuit.traj"
 grep -q "TAA history kept on" "$out/stdout" || { echo "FAIL: no TAA history share printed"; failures=$((failures + 1)); }
+# The budget controller over a trajectory: every frame's decision in PREFIX_control.json, and
+# per-group levels given by name.
+expect_render budget "budget_0004_left.png budget_control.json" --budget-ms 50 --trajectory "$data/gaze_pursuit.traj"
+if ! grep -q '"frames_over_budget"' "$out/budget_control.json" || ! grep -q '"predicted_error"' "$out/budget_control.json" ||
+   ! grep -q "controller: budget 50.00 ms" "$out/stdout"; then
+  echo "FAIL (budget): no per-frame decisions in budget_control.json or no summary"
+  failures=$((failures + 1))
+fi
+if "$exe" render cornell-caustics "${small[@]}" --effects specular=reflections,rest=shadows --out "$out/groups" \
+     >"$out/stdout" 2>"$out/stderr" && [ -s "$out/groups_left.png" ]; then
+  echo "ok   (effect groups by name)"
+else
+  echo "FAIL (effect groups by name): $(tail -3 "$out/stderr")"
+  failures=$((failures + 1))
+fi
 # A viewer's settings file (foveation and TAA on) gives the reference its view; the reference
 # renders every pixel regardless.
 echo '{"foveated": true, "taa": true, "photons": "16x16", "head": {"position": [0.25, 0.1, 1.2], "orientation": [0, 0, 0, 1]}}' \

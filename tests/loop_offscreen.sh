@@ -18,4 +18,12 @@ grep -q '"missed_deadlines":0,' "$out/flat" || fail "deadlines missed at 1 Hz"
 grep -q '"handover":"hoststagingbuffer"' "$out/flat" || fail "no Vulkan hand-over"
 grep -q '"cpu_ms":{"max":[0-9.e-]*,"mean":[0-9.e-]*,"p50":[0-9.e-]*,"p99":[0-9.e-]*}' "$out/flat" || fail "no cpu_ms percentiles"
 grep -q '"handover_ms":{' "$out/flat" || fail "no hand-over timing"
+# Under the budget controller: its decisions in the statistics, a summary line, no frame lost
+# (the stats outlive the controller: this once read freed memory).
+"$exe" xr --offscreen --backend cpu --eye-size 48x40 --frames 12 --warmup 2 --refresh 1 --handover none \
+  --budget-ms 500 --stats "$out/budget.json" >"$out/log" 2>&1 || { cat "$out/log"; fail "exit code $? under --budget-ms"; }
+tr -d ' \n' <"$out/budget.json" >"$out/flat"
+grep -q '"controller":{"budget_ms":500' "$out/flat" || fail "no controller in the statistics"
+grep -q '"change":"start"' "$out/flat" || fail "no per-frame decisions"
+grep -q "controller: budget 500.00 ms" "$out/log" || fail "no controller summary"
 echo "offscreen loop ok"
