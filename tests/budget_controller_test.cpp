@@ -262,7 +262,7 @@ TEST(BudgetController, HoldsTheBudgetOnTheRecordedSponzaWalk) {
     // On this walk the cost is nearly constant after its first seconds, so the best fixed setting,
     // chosen in hindsight from the whole walk at the budget's edge, is close to the controller's
     // final one plus what its safety margin leaves unused: the controller must stay within 20 %
-    // of it (measured: 5 % above at 11.1 ms, 0.4 % above at 5.5 ms; docs/ray-vr.md).
+    // of it (measured: 5 % above at 11.1 ms, 1 % above at 5.5 ms; docs/ray-vr.md).
     EXPECT_LT(run.meanError(), 1.2 * bestFixed) << budget;
     std::printf("budget %.2f ms: best setting up to %.1f ms (%.1fx), controller p99 %.2f ms, %.2f %% over, mean "
                 "predicted relMSE %.4f against the best fixed setting's %.4f\n",

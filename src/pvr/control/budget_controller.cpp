@@ -422,9 +422,9 @@ ControlDecision BudgetController::decide(double nowMs) {
         if (!(chosen == current_)) {
           current_ = chosen;
           lastRaiseMs_ = nowMs;
-          headroomFrames_ = 0;
           d.change = "raise";
         }
+        headroomFrames_ = 0;  // found or not, the next search waits for `holdFrames` more
       }
     }
   }
