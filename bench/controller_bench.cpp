@@ -87,6 +87,12 @@ Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFr
   return w;
 }
 
+std::string fmt2(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f", v);
+  return b;
+}
+
 }  // namespace
 
 int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json) {
@@ -141,6 +147,7 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
     const FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
     // The sampled views' references.
     std::vector<SampledView> views;
+    const auto referenceStart = Clock::now();
     for (size_t f = 0; f < trajectory.size(); f += size_t(args.errorEvery)) {
       StereoRig vr = rig;
       vr.head = trajectory[f].head;
@@ -154,7 +161,7 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
       for (int i = 0; i < args.referencePasses; ++i) reference.addPass();
       views.push_back({int(f), {reference.image(Eye::Left), reference.image(Eye::Right)}});
     }
-    std::printf("| %s | references: %zu views |\n", scene.name.c_str(), views.size());
+    std::printf("| %s | references: %zu views in %.0f s |\n", scene.name.c_str(), views.size(), msSince(referenceStart) / 1000.0);
     std::printf("| %s | %zu frames, %dx%d per eye, radius %g, profile %s, %zu reference views |\n", scene.name.c_str(),
                 trajectory.size(), rig.width, rig.height, base.gather.density.radius,
                 calibrated ? profilePath.c_str() : "generic (no calibrated profile found)", views.size());
@@ -213,13 +220,28 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
         candidates[BudgetController::toJson(fewer, profile).dump()] = fewer;
       }
     }
+    // The real-time defaults (README's headline frame: 512^2 photons, the asked radius, no
+    // denoiser, full resolution, every group at gi): how far the walk is over the budgets without
+    // a controller.
+    ControlSetting defaults;
+    {
+      const auto& sides = profile.photonSides;
+      defaults.photons = int(std::find(sides.begin(), sides.end(), 512u) - sides.begin());
+      const auto& scales = profile.radiusScales;
+      defaults.radius = int(std::find(scales.begin(), scales.end(), 1.0f) - scales.begin());
+      defaults.levels.fill(uint8_t(EffectLevel::Gi));
+      if (defaults.photons < int(sides.size()) && defaults.radius < int(scales.size()))
+        candidates[BudgetController::toJson(defaults, profile).dump()] = defaults;
+    }
+    const std::string defaultsName = BudgetController::toJson(defaults, profile).dump();
     std::vector<std::pair<std::string, Walk>> fixed;
     for (const auto& [key, setting] : candidates) {
       const RenderOptions o = model.optionsFor(setting);
       Walk w = walk(*renderer, rig, trajectory, views, [&](double) { return o; }, [](const StageTimings&, double) {},
                     args.fixedStride);
       w.name = key;
-      std::printf("| %s | walked: fixed %s, p99 %.2f ms |\n", scene.name.c_str(), key.c_str(), w.p99());
+      std::printf("| %s | walked: fixed %s%s, p99 %.2f ms, max %.2f ms |\n", scene.name.c_str(), key == defaultsName ? "(the defaults) " : "",
+                  key.c_str(), w.p99(), *std::max_element(w.ms.begin(), w.ms.end()));
       fixed.emplace_back(key, std::move(w));
     }
     for (size_t b = 0; b < budgets.size(); ++b) {
@@ -244,7 +266,10 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
         const auto [t, meets] = row(w, name, false);
         std::printf("| %s | %.2f ms | fixed %s | %.2f / %.2f / %.2f | %.2f %% | %.4f | %s | %s |\n", scene.name.c_str(),
                     budget, name.c_str(), t.mean, t.p50, t.p99, 100.0 * w.overFraction(budget), w.meanError(),
-                    meets ? "yes" : "no", name == bestFixedName ? "best fixed that meets it" : "");
+                    meets ? "yes" : "no",
+                    name == bestFixedName ? "best fixed that meets it"
+                    : name == defaultsName ? ("the defaults: p99 " + fmt2(t.p99 / budget) + "x, max " + fmt2(*std::max_element(w.ms.begin(), w.ms.end()) / budget) + "x the budget").c_str()
+                                           : "");
       }
       json.push_back({{"suite", "controller"}, {"scene", scene.name}, {"budget_ms", budget}, {"policy", "summary"},
                       {"controller", {{"frame", ct}, {"over_fraction", c.overFraction(budget)}, {"mean_rel_mse", c.meanError()},
@@ -256,6 +281,7 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
       nlohmann::json frames = w.ms, errors = nlohmann::json::array();
       for (const auto& [frame, error] : w.error) errors.push_back({frame, error});
       json.push_back({{"suite", "controller"}, {"scene", scene.name}, {"policy", "fixed"}, {"setting", nlohmann::json::parse(name)},
+                      {"defaults", name == defaultsName},
                       {"frame", latencyStats(w.ms)}, {"mean_rel_mse", w.meanError()}, {"frame_ms", frames},
                       {"frame_stride", args.fixedStride}, {"errors", errors}});
     }

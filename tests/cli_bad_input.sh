@@ -178,5 +178,19 @@ else
   echo "ok   (nan_and_degenerate.obj): $(cat "$out/stderr")"
 fi
 
+# Input limits (pvr/util/input_limits.h; the others are tested with lowered limits in pvr_tests).
+yes "0 0 0 0 0 0 1 0.5 0.5" 2>/dev/null | head -n 1000001 >"$out/long.traj"
+expect_error "has more than 1000000 frames: at most 1000000" render cornell "${small[@]}" --trajectory "$out/long.traj"
+rm -f "$out/long.traj"
+
+# The soak's arguments.
+soak=(soak cornell --backend cpu --eye-size 8x8 --photons 16x16 --json "$out/soak.json")
+expect_error "at least three cycles" "${soak[@]}" --frames 20 --change-every 1
+expect_error "multiple of the options' cycle" "${soak[@]}" --frames 60 --change-every 2 --reload-every 30
+expect_error "change-every must be between" "${soak[@]}" --change-every 0
+expect_error "at most 100000000 frames" "${soak[@]}" --frames 1000000000
+expect_error "max-rss-growth must be" "${soak[@]}" --frames 60 --change-every 2 --max-rss-growth -1
+expect_error "empty scene name" "${soak[@]}" --frames 60 --change-every 2 --reload-scenes cornell,,cornell
+
 [ "$failures" -eq 0 ] && echo "all bad-input cases passed" || echo "$failures bad-input case(s) failed"
 exit $((failures > 0))

@@ -127,6 +127,66 @@ TEST(FramePipeline, RunsTheStagesInOneOrder) {
   EXPECT_EQ(joined(r.calls), "trace, build, forget left, eye right alone, forget right, finish, read right");
 }
 
+// Below gi nothing gathers photons: after the first frame (whose map makes the buffers) no
+// photons are traced and no map is built; back at gi, every slice of a rolling map is traced again.
+TEST(FramePipeline, FramesWithNothingAtGiTraceNoPhotons) {
+  auto backend = std::make_unique<RecordingBackend>();
+  RecordingBackend& r = *backend;
+  Material wall, mirror;
+  mirror.type = MaterialType::Mirror;
+  mirror.effectGroup = 1;
+  FrameRenderer renderer(std::move(backend), {wall, mirror});
+  RenderOptions o;
+  o.photonBatches = 2;
+  o.gather.overrideEffects = true;
+  o.gather.effects = EffectLevel::Shadows;
+  renderer.render(tinyRig(), o, false);
+  EXPECT_EQ(joined(r.calls), "trace, trace, build, eye left alone, forget left, eye right alone, forget right, finish");
+  for (EffectLevel level : {EffectLevel::Raster, EffectLevel::Shadows, EffectLevel::Reflections, EffectLevel::Path}) {
+    r.calls.clear();
+    o.gather.effects = level;
+    renderer.render(tinyRig(), o, false);
+    EXPECT_EQ(joined(r.calls), "eye left alone, forget left, eye right alone, forget right, finish") << effectLevelName(level);
+  }
+  // One group (the mirror's) at gi: photons again, all slices (not the rolling one).
+  o.gather.overrideEffects = false;
+  o.gather.groupEffects[0] = uint8_t(EffectLevel::Shadows);
+  o.gather.groupEffects[1] = uint8_t(EffectLevel::Gi);
+  r.calls.clear();
+  renderer.render(tinyRig(), o, false);
+  EXPECT_EQ(joined(r.calls), "trace, trace, build, eye left alone, forget left, eye right alone, forget right, finish");
+  r.calls.clear();
+  renderer.render(tinyRig(), o, false);
+  EXPECT_EQ(joined(r.calls), "trace, build, eye left alone, forget left, eye right alone, forget right, finish");
+}
+
+// On the CPU backend a frame at shadows after a gi frame of other photons is the frame a fresh
+// renderer makes: the stale map is not read.
+TEST(FramePipeline, AFrameBelowGiDoesNotReadTheLastMap) {
+  Scene scene = builtinScene("cornell");
+  StereoRig rig = tinyRig();
+  RenderOptions gi;
+  gi.photonsX = gi.photonsY = 24;
+  RenderOptions shadows;
+  shadows.photonsX = shadows.photonsY = 64;
+  shadows.gather.overrideEffects = true;
+  shadows.gather.effects = EffectLevel::Shadows;
+  FrameRenderer fresh = makeCpuFrameRenderer(scene);
+  const FrameResult expected = fresh.render(rig, shadows);
+  FrameRenderer used = makeCpuFrameRenderer(scene);
+  used.render(rig, gi);
+  const FrameResult f = used.render(rig, shadows);
+  EXPECT_EQ(f.storedPhotons, 0u);
+  EXPECT_EQ(f.timings.photonTraceMs, 0.0);
+  EXPECT_EQ(f.timings.mapBuildMs, 0.0);
+  for (int e = 0; e < 2; ++e) {
+    const std::vector<Vec3>&a = f.eyes[e].image.pixels, &b = expected.eyes[e].image.pixels;
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i)
+      ASSERT_TRUE(a[i].x == b[i].x && a[i].y == b[i].y && a[i].z == b[i].z) << "eye " << e << " pixel " << i;
+  }
+}
+
 // Each eye's outputs are present exactly when a stage of the frame wrote them.
 TEST(FramePipeline, ResultsHoldWhatTheStagesWrote) {
   FoveationMask mask = generateFoveationMask(maskParamsForRig(tinyRig()));

@@ -20,6 +20,7 @@
 #include "pvr/app/options.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/app/loop_commands.h"
+#include "pvr/app/soak.h"
 #include "pvr/app/trajectory.h"
 #include "map_bench.h"
 #include "pvr/image/image_compare.h"
@@ -765,6 +766,27 @@ int runCli(int argc, char** argv) {
   view->add_option("--keys", vl.keys, "Scripted key presses FRAME:KEY,... (e.g. 3:F12,5:Escape)");
   view->add_flag("--no-panel", vl.noPanel, "No options panel");
 
+  RenderArgs sa;
+  SoakArgs soakArgs;
+  std::string reloadScenes;
+  CLI::App* soak = app.add_subcommand(
+      "soak", "Run the frame loop for many frames while every option cycles and the scene reloads; checks that no pixel is "
+              "ever non-finite and that host memory, GPU memory and file descriptors stay flat (docs/reliability.md)");
+  soak->add_option("scene", sa.scene, "Built-in scene name or scene/mesh file")->capture_default_str();
+  addRenderOptions(*soak, sa);
+  soak->add_option("--eye-size", sa.eyeSize, "Per-eye size WxH (default: 1440x1600)");
+  soak->add_option("--trajectory", sa.trajectory, "Head poses and gaze, one frame per line (cycled; default: a sway)");
+  soak->add_option("--frames", soakArgs.frames, "Frames to render (at least three cycles of the options)")->capture_default_str();
+  soak->add_option("--change-every", soakArgs.changeEvery, "Frames between option changes (10 states: a cycle of 10x this)")
+      ->capture_default_str();
+  soak->add_option("--reload-every", soakArgs.reloadEvery, "Frames between scene reloads, a multiple of the cycle (0: each cycle)")
+      ->capture_default_str();
+  soak->add_option("--reload-scenes", reloadScenes, "Comma-separated scenes the reloads cycle through (default: the scene again)");
+  soak->add_option("--json", soakArgs.json, "Where to write the samples and checks")->capture_default_str();
+  soak->add_option("--max-rss-growth", soakArgs.maxRssGrowthMiB, "Allowed resident-set growth after warm-up, MiB")->capture_default_str();
+  soak->add_option("--max-p99-ratio", soakArgs.maxP99Ratio, "Fail if the last cycle's p99 over the first's exceeds this (0: report only)")
+      ->capture_default_str();
+
   MapBenchArgs ba;
   FrameBenchArgs fa;
   CLI::App* bench = app.add_subcommand(
@@ -869,6 +891,23 @@ int runCli(int argc, char** argv) {
       ls.options = setup->options;
       ls.trajectory = setup->trajectory;
       return cmd == xr ? runXrCommand(*l, ls) : runViewCommand(*l, ls);
+    }
+    if (soak->parsed()) {
+      soakArgs.scene = sa.scene;
+      for (size_t start = 0; !reloadScenes.empty() && start <= reloadScenes.size();) {
+        const size_t comma = std::min(reloadScenes.find(',', start), reloadScenes.size());
+        if (comma == start) throw Error("--reload-scenes: an empty scene name in '" + reloadScenes + "'");
+        soakArgs.reloadScenes.push_back(reloadScenes.substr(start, comma - start));
+        start = comma + 1;
+      }
+      std::unique_ptr<RenderSetup> setup = setUpRender(sa);
+      LoopSetup ls;
+      ls.backend = setup->backend;
+      ls.scene = &setup->scene;
+      ls.rig = setup->rig;
+      ls.options = setup->options;
+      ls.trajectory = setup->trajectory;
+      return runSoakCommand(soakArgs, ls);
     }
     if (bench->parsed()) {
       if (fa.suite == "maps") return runMapBench(ba);

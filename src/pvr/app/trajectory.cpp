@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "pvr/util/error.h"
+#include "pvr/util/input_limits.h"
 
 namespace pvr {
 
@@ -13,7 +14,7 @@ std::vector<TrajectoryFrame> loadTrajectory(const std::string& path) {
   if (!in) throw Error("cannot open trajectory '" + path + "': no such file or not readable");
   std::vector<TrajectoryFrame> frames;
   std::string line;
-  for (int lineNumber = 1; std::getline(in, line); ++lineNumber) {
+  for (uint64_t lineNumber = 1; std::getline(in, line); ++lineNumber) {
     std::string where = "trajectory '" + path + "' line " + std::to_string(lineNumber);
     line = line.substr(0, line.find('#'));
     std::istringstream fields(line);
@@ -47,6 +48,9 @@ std::vector<TrajectoryFrame> loadTrajectory(const std::string& path) {
         frame.gaze[e][k] = g;
       }
     frame.verge = v.size() == 9;
+    if (frames.size() >= inputLimits().trajectoryFrames)
+      throw Error("trajectory '" + path + "' has more than " + std::to_string(inputLimits().trajectoryFrames) +
+                  " frames: at most " + std::to_string(inputLimits().trajectoryFrames));
     frames.push_back(frame);
   }
   if (frames.empty()) throw Error("trajectory '" + path + "' has no frames");

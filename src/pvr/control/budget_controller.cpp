@@ -245,7 +245,7 @@ bool BudgetController::hasGi(const ControlSetting& s) const {
 
 ControlCosts BudgetController::scaleOf(const ControlSetting& s) const {
   ControlCosts scale;
-  // Without a group at gi nothing gathers photons: the fewest are traced (optionsFor).
+  // Without a group at gi nothing gathers photons: none are traced (FrameRenderer).
   const double side = hasGi(s) ? profile_.photonSides[size_t(s.photons)] : profile_.photonSides.front();
   const double photons = side * side / (double(profile_.photonSides.back()) * profile_.photonSides.back());  // of the top count
   const double r = profile_.radiusScales[size_t(s.radius)];
@@ -257,7 +257,7 @@ ControlCosts BudgetController::scaleOf(const ControlSetting& s) const {
     rays += profile_.levelRayCost[size_t(g)][size_t(level)];
   }
   const double fp = profile_.photonFixedShare, fd = profile_.densityFixedShare;
-  scale.photonMs = fp + (1.0 - fp) * photons;
+  scale.photonMs = hasGi(s) ? fp + (1.0 - fp) * photons : 0.0;
   scale.densityMs = fd + (1.0 - fd) * photons * r * r * std::max(giShare, hasGi(s) ? kMinShare : 0.0) * samples;
   scale.rayMs = std::max(rays, kMinShare) * samples;
   scale.denoiseMs = profile_.denoiseIterations[size_t(s.denoise)];

@@ -74,7 +74,7 @@ class CpuFrameBackend : public FrameBackend {
 
 // A frame renderer on the CPU reference backend.
 inline FrameRenderer makeCpuFrameRenderer(const Scene& scene) {
-  return FrameRenderer(std::make_unique<CpuFrameBackend>(scene));
+  return FrameRenderer(std::make_unique<CpuFrameBackend>(scene), scene.materials());
 }
 
 }  // namespace pvr

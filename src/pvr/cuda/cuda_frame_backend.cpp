@@ -1,5 +1,7 @@
 #include "pvr/cuda/cuda_frame_backend.h"
 
+#include <cuda_runtime.h>
+
 #include <algorithm>
 #include <cstring>
 
@@ -13,6 +15,7 @@
 #include "pvr/cuda/temporal.cuh"
 #include "pvr/foveation/mask.h"
 #include "pvr/raster/gbuffer_raster.h"
+#include "pvr/scene/scene.h"
 
 namespace pvr {
 
@@ -370,6 +373,19 @@ double CudaFrameBackend::buildHashGrid(const std::vector<Photon>& photons, float
   m.gridView = m.grid.view();
   std::sort(times.begin(), times.end());
   return times[times.size() / 2];
+}
+
+FrameRenderer makeCudaFrameRenderer(const Scene& scene) {
+  return FrameRenderer(std::make_unique<CudaFrameBackend>(scene), scene.materials());
+}
+
+size_t cudaDeviceMemoryUsedBytes() {
+  size_t freeBytes = 0, total = 0;
+  if (cudaMemGetInfo(&freeBytes, &total) != cudaSuccess) {
+    cudaGetLastError();
+    return 0;
+  }
+  return total - freeBytes;
 }
 
 }  // namespace pvr

@@ -69,8 +69,9 @@ class CudaFrameBackend : public FrameBackend {
 };
 
 // A frame renderer on the CUDA backend; throws pvr::Error if no GPU can be used.
-inline FrameRenderer makeCudaFrameRenderer(const Scene& scene) {
-  return FrameRenderer(std::make_unique<CudaFrameBackend>(scene));
-}
+FrameRenderer makeCudaFrameRenderer(const Scene& scene);
+
+// The current GPU's memory in use by every client (cudaMemGetInfo: total - free); 0 on failure.
+size_t cudaDeviceMemoryUsedBytes();
 
 }  // namespace pvr

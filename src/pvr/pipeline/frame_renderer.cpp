@@ -112,7 +112,8 @@ void FrameDataflow::run(const StageIO& io) {
   for (const DataRef& w : io.writes) written_[slot(w.data, w.eye)] = true;
 }
 
-FrameRenderer::FrameRenderer(std::unique_ptr<FrameBackend> backend) : backend_(std::move(backend)) {
+FrameRenderer::FrameRenderer(std::unique_ptr<FrameBackend> backend, std::vector<Material> materials)
+    : backend_(std::move(backend)), materials_(std::move(materials)) {
   if (!backend_) throw Error("a frame renderer needs a backend");
 }
 
@@ -131,6 +132,13 @@ bool samePicture(const RenderOptions& a, const RenderOptions& b) {
   for (int e = 0; e < 2 && same && a.foveation.mask; ++e)
     same = a.foveation.gaze[e][0] == b.foveation.gaze[e][0] && a.foveation.gaze[e][1] == b.foveation.gaze[e][1];
   return same;
+}
+
+// Whether any surface's effect level gathers photons (gi); with no materials known, yes.
+bool gathersPhotons(const GatherParams& params, const std::vector<Material>& materials) {
+  if (materials.empty()) return true;
+  return std::any_of(materials.begin(), materials.end(),
+                     [&](const Material& m) { return effectLevelOf(params, m) == EffectLevel::Gi; });
 }
 
 // Whether two frames' options trace the same photons (a rolling map may keep its slices).
@@ -199,8 +207,11 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
   FrameDataflow flow;
   FrameResult frame;
 
+  // Below gi nothing reads the map: no photons are traced and the last map (or, before the first,
+  // a map of this frame's photons, so that its buffers exist) stays unread.
+  const bool photons = !mapBuilt_ || gathersPhotons(options.gather, materials_);
   flow.run(photonTraceIO());
-  {
+  if (photons) {
     StageScope scope(clock, Stage::PhotonTrace);
     // A rolling map retraces one slice a frame; all of them at first, after a change of the
     // photons' options, and while refining (each still frame wants photons of its own).
@@ -222,11 +233,14 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
     }
     photonsHeld_ = true;
     lastPhotonOptions_ = requested;
+  } else {
+    photonsHeld_ = false;  // the next gi frame traces every slice afresh
   }
   flow.run(mapBuildIO());
-  {
+  if (photons) {
     StageScope scope(clock, Stage::MapBuild);
     frame.mapBytes = backend.buildPhotonMap(options.map, options.gather.density.radius);
+    mapBuilt_ = true;
   }
 
   const bool raster = options.primary == PrimaryVisibility::Raster;

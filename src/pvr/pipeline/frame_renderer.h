@@ -10,14 +10,18 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pvr/pipeline/frame_backend.h"
+#include "pvr/shading/material.h"
 
 namespace pvr {
 
 class FrameRenderer {
  public:
-  explicit FrameRenderer(std::unique_ptr<FrameBackend> backend);
+  // `materials`: the scene's, to tell when no surface gathers photons (every material's effect
+  // level below gi): those frames trace no photons and build no map. Empty: always traced.
+  explicit FrameRenderer(std::unique_ptr<FrameBackend> backend, std::vector<Material> materials = {});
 
   // Traces photons, builds the map and shades the requested eyes. With images = false the
   // images stay where they were rendered (benchmarks). With options.temporal on, each eye's
@@ -53,6 +57,8 @@ class FrameRenderer {
 
  private:
   std::unique_ptr<FrameBackend> backend_;
+  std::vector<Material> materials_;
+  bool mapBuilt_ = false;  ///< the backend has built a photon map (the eye passes' buffers exist)
   bool freshNoise_ = true;
   std::optional<StereoRig> lastRig_;  ///< the last frame's view and options: is this one still?
   RenderOptions lastOptions_;

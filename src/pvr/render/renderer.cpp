@@ -38,10 +38,19 @@ std::unique_ptr<FrameBackend> makeFrameBackend(BackendKind kind, const Scene& sc
 }
 
 std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& scene) {
-  return std::make_unique<FrameRenderer>(makeFrameBackend(kind, scene));
+  return std::make_unique<FrameRenderer>(makeFrameBackend(kind, scene), scene.materials());
 }
 
-Renderer::Renderer(const Scene& scene, BackendKind backend) : rig_(scene.rig), frames_(makeFrameBackend(backend, scene)) {}
+Renderer::Renderer(const Scene& scene, BackendKind backend)
+    : rig_(scene.rig), frames_(makeFrameBackend(backend, scene), scene.materials()) {}
+
+size_t gpuMemoryUsedBytes() {
+#ifdef PVR_HAVE_CUDA
+  return cudaDeviceMemoryUsedBytes();
+#else
+  return 0;
+#endif
+}
 
 FrameResult Renderer::renderFrame(const Pose& head, const float gaze[2], FrameOutput output) {
   rig_.head = head;

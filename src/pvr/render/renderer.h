@@ -23,6 +23,10 @@ bool cudaBackendAvailable(std::string* why = nullptr);
 std::unique_ptr<FrameBackend> makeFrameBackend(BackendKind kind, const Scene& scene);
 std::unique_ptr<FrameRenderer> makeFrameRenderer(BackendKind kind, const Scene& scene);
 
+// Bytes of the CUDA GPU's memory in use, by every client (the driver's count: total - free); 0
+// without a usable GPU. What the backend's own count (FrameResult::deviceBytes) may not see.
+size_t gpuMemoryUsedBytes();
+
 // What renderFrame gives back of the eyes' images.
 enum class FrameOutput : int {
   HostImages = 0,     ///< copied to host memory (FrameResult::eyes)

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pvr/util/error.h"
+#include "pvr/util/input_limits.h"
 
 namespace pvr {
 
@@ -61,6 +62,10 @@ void Scene::addMesh(const std::string& meshName, const std::vector<Vec3>& vertic
   vertices_.insert(vertices_.end(), vertices.begin(), vertices.end());
   if (withNormals) normals_.insert(normals_.end(), normals.begin(), normals.end());
   else if (!normals_.empty()) normals_.resize(vertices_.size(), Vec3(0.0f));  // zero: use geometric normal
+  const uint64_t maxTriangles = inputLimits().triangles;
+  if (uint64_t(triangleCount()) + indices.size() / 3 > maxTriangles)
+    throw Error("mesh '" + meshName + "' brings the scene to " + std::to_string(uint64_t(triangleCount()) + indices.size() / 3) +
+                " triangles: at most " + std::to_string(maxTriangles));
   MeshRange range{meshName, triangleCount(), 0};
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     uint32_t i0 = indices[t], i1 = indices[t + 1], i2 = indices[t + 2];
@@ -122,8 +127,20 @@ void Scene::finalize() {
 
 uint32_t Scene::addTexture(const std::string& textureName, int width, int height, std::vector<uint32_t> rgba, bool srgb,
                            WrapMode wrapS, WrapMode wrapT) {
-  if (width <= 0 || height <= 0 || width > 32768 || height > 32768 || rgba.size() != size_t(width) * size_t(height))
+  const InputLimits& limits = inputLimits();
+  if (width <= 0 || height <= 0 || rgba.size() != size_t(width) * size_t(height))
     throw Error("texture '" + textureName + "' has a bad size (" + std::to_string(width) + "x" + std::to_string(height) + ")");
+  if (width > limits.textureSide || height > limits.textureSide)
+    throw Error("texture '" + textureName + "' is " + std::to_string(width) + "x" + std::to_string(height) + ": at most " +
+                std::to_string(limits.textureSide) + " texels per side");
+  if (textures_.size() >= limits.textures)
+    throw Error("texture '" + textureName + "': a scene has at most " + std::to_string(limits.textures) + " textures");
+  uint64_t bytes = 0;
+  for (const std::vector<uint32_t>& held : textureTexels_) bytes += held.size() * sizeof(uint32_t);
+  bytes += uint64_t(width) * uint64_t(height) * sizeof(uint32_t) * 4 / 3;  // with its mip levels
+  if (bytes > limits.textureBytes)
+    throw Error("texture '" + textureName + "': the scene's textures would take " + std::to_string(bytes >> 20) +
+                " MiB with their mip levels, at most " + std::to_string(limits.textureBytes >> 20) + " MiB");
   TextureView t;
   t.width = width, t.height = height;
   t.wrapS = wrapS, t.wrapT = wrapT;

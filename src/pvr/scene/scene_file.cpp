@@ -9,6 +9,7 @@
 
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "pvr/util/input_limits.h"
 
 namespace pvr {
 namespace {
@@ -115,6 +116,11 @@ void readAim(const json& light, const std::string& what, Vec3& center, float& ra
 Scene loadJsonScene(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error("cannot open '" + path + "'");
+  std::error_code ec;
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > inputLimits().sceneFileBytes)
+    throw Error("scene file '" + path + "' is " + std::to_string(bytes >> 20) + " MiB: at most " +
+                std::to_string(inputLimits().sceneFileBytes >> 20) + " MiB");
   json doc;
   try {
     doc = json::parse(in);
