@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes photonvr's input parsers with libFuzzer (clang, ASan + UBSan, leaks checked): the JSON
-# scene format, mesh import (glTF/GLB/OBJ through assimp), foveation masks and trajectories.
+# scene format, mesh import (glTF/GLB/OBJ through assimp), foveation masks, trajectories and the
+# command line (parsed and checked, nothing run).
 #   usage: scripts/fuzz.sh [SECONDS_PER_HARNESS (default 30)] [BUILD_DIR (default build-fuzz)]
 # Seeds: the project's test data and scenes, and Debian's assimp-testmodels (its glTF2 samples,
 # broken glTF2 files and invalid/ models). Prints one line per harness (executions, findings);
@@ -14,7 +15,7 @@ build=${2:-build-fuzz}
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPVR_ENABLE_CUDA=OFF -DPVR_FUZZ=ON \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
-harnesses=(scene_json mesh mask trajectory)
+harnesses=(scene_json mesh mask trajectory cli)
 cmake --build "$build" -j"$(nproc)" --target "${harnesses[@]/#/pvr_fuzz_}" >/dev/null
 
 models=/usr/share/assimp/models
@@ -30,6 +31,7 @@ seed mesh tests/data/*.obj tests/data/*.gltf $(find "$models/glTF2" $models/inva
   \( -name '*.gltf' -o -name '*.glb' -o -name '*.obj' \) -size -40k 2>/dev/null | sort)
 seed mask tests/fuzz/corpus/mask/*
 seed trajectory tests/data/*.traj
+seed cli tests/fuzz/corpus/cli/*
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
 export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0
 failures=0

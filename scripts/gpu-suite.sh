@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The GPU suite, run on a GPU machine from a bundle of this build (made here by
 #   ../shared/gpu/bundle.sh .gpu build/photonvr build/tests/pvr_gpu_tests):
-# the CUDA-vs-CPU tests, every render mode and the GPU bad-input cases through the executable, and
+# the CUDA-vs-CPU tests, every render mode, the GPU bad-input cases and injected faults (out of
+# memory at every allocation, a lost device) through the executable, and
 # compute-sanitizer (memcheck, racecheck, synccheck, initcheck) on representative render modes
 # (TAA with scatter reuse, foveated gather, denoised with a rolling photon map, the surface cache).
 #   usage: scripts/gpu-suite.sh BUNDLE_DIR LOG_DIR [--no-sanitizer]
@@ -30,6 +31,7 @@ part() {  # name, command...
 part gpu_tests "$bundle/run.sh" "$bundle/bin/pvr_gpu_tests"
 part cli_modes_cuda bash tests/cli_modes.sh "$bundle/photonvr" tests/data cuda
 part gpu_bad_input bash tests/gpu_bad_input.sh "$bundle/photonvr"
+part gpu_faults bash tests/gpu_faults.sh "$bundle/photonvr" tests/data
 if [ "${3:-}" != --no-sanitizer ] && command -v compute-sanitizer >/dev/null; then
   small=(--backend cuda --eye-size 320x352 --photons 128x128 --out /tmp/pvr_sanitized)
   for tool in memcheck racecheck synccheck initcheck; do

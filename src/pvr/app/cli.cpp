@@ -29,6 +29,7 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "pvr/util/fault_injection.h"
 
 namespace pvr {
 namespace {
@@ -345,23 +346,10 @@ struct RenderSetup {
   std::vector<TrajectoryFrame> trajectory;
 };
 
-std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
-  auto setup = std::make_unique<RenderSetup>();
-  setup->backend = parseBackendKind(a.backend);
-  setup->scene = loadScene(a.scene);
-  Scene& scene = setup->scene;
-  StereoRig& rig = setup->rig;
-  rig = scene.rig;
-  if (a.head) rig.head = *a.head;
-  RenderOptions& options = setup->options;
-  options = toOptions(a, rig);
-  if (a.effects.find('=') != std::string::npos) setGroupEffects(a.effects, scene, options.gather);
-  const std::vector<std::string> builtins = builtinSceneNames();
-  if (a.radius.empty() && std::find(builtins.begin(), builtins.end(), a.scene) == builtins.end()) {
-    Bounds3 b = scene.bounds();  // a scene of any size: the radius follows it
-    options.gather.density.radius = std::max(0.004f * length(b.extent()), 1e-6f);
-  }
-  FoveationMask& mask = setup->mask;
+// The options from the command line alone, every check that needs no scene, device or file but
+// the settings already read: what `CliRun::CheckOnly` runs (the command-line fuzz harness).
+RenderOptions optionsFromArgs(const RenderArgs& a, StereoRig& rig) {
+  RenderOptions options = toOptions(a, rig);
   if (a.acuity != "linear" && a.acuity != "geisler-perry")
     throw Error("--acuity must be linear or geisler-perry, got '" + a.acuity + "'");
   if (a.foveated) {
@@ -370,12 +358,6 @@ std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
     if (std::sscanf(a.gaze.c_str(), "%f,%f%c", &gx, &gy, &extra) != 2)
       throw Error("--gaze must be X,Y (image fractions, 0.5,0.5 = centre), got '" + a.gaze + "'");
     options.foveation.gaze[0][0] = gx, options.foveation.gaze[0][1] = gy;
-    validateOptions(options, rig);  // before the mask is made: a bad gaze need not wait for it
-    MaskParams params = maskParamsForRig(rig);
-    if (a.acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
-    mask = a.mask.empty() ? generateFoveationMask(params) : loadFoveationMask(a.mask);
-    options.foveation.mask = &mask;
-    options.foveation.verge = true;  // both eyes fixate what the left eye's gaze meets
   } else if (!a.mask.empty()) {
     throw Error("--mask is for --foveated rendering");
   }
@@ -391,7 +373,35 @@ std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
   options.denoise.enabled = a.denoise;
   options.denoise.params.iterations = a.denoiseIterations;
   options.photonBatches = a.photonBatches;
-  validateOptions(options, rig);  // all of them, before any work
+  validateOptions(options, rig);  // before the scene-dependent work: a bad value need not wait for it
+  return options;
+}
+
+std::unique_ptr<RenderSetup> setUpRender(const RenderArgs& a) {
+  auto setup = std::make_unique<RenderSetup>();
+  setup->backend = parseBackendKind(a.backend);
+  setup->scene = loadScene(a.scene);
+  Scene& scene = setup->scene;
+  StereoRig& rig = setup->rig;
+  rig = scene.rig;
+  if (a.head) rig.head = *a.head;
+  RenderOptions& options = setup->options;
+  options = optionsFromArgs(a, rig);
+  if (a.effects.find('=') != std::string::npos) setGroupEffects(a.effects, scene, options.gather);
+  const std::vector<std::string> builtins = builtinSceneNames();
+  if (a.radius.empty() && std::find(builtins.begin(), builtins.end(), a.scene) == builtins.end()) {
+    Bounds3 b = scene.bounds();  // a scene of any size: the radius follows it
+    options.gather.density.radius = std::max(0.004f * length(b.extent()), 1e-6f);
+  }
+  FoveationMask& mask = setup->mask;
+  if (a.foveated) {
+    MaskParams params = maskParamsForRig(rig);
+    if (a.acuity == "geisler-perry") params.acuity.kind = AcuityKind::GeislerPerry;
+    mask = a.mask.empty() ? generateFoveationMask(params) : loadFoveationMask(a.mask);
+    options.foveation.mask = &mask;
+    options.foveation.verge = true;  // both eyes fixate what the left eye's gaze meets
+  }
+  validateOptions(options, rig);  // again, with the scene's radius and the mask
   if (!a.trajectory.empty()) setup->trajectory = loadTrajectory(a.trajectory);
   if (scene.skippedTriangles() > 0)
     std::cerr << "photonvr: warning: skipped " << scene.skippedTriangles()
@@ -654,7 +664,14 @@ int runMask(const MaskArgs& a) {
 
 }  // namespace
 
-int runCli(int argc, char** argv) {
+int runCli(int argc, char** argv, CliRun run) {
+  const bool execute = run == CliRun::Execute;
+  // CheckOnly: the options' conversion and checks for a default rig; nothing loaded or rendered.
+  auto checkOnly = [](const RenderArgs& a) {
+    StereoRig rig;
+    optionsFromArgs(a, rig);
+    return 0;
+  };
   CLI::App app{"photonvr: real-time photon mapping for VR headsets (CUDA backend, and the CPU reference: Embree + TBB)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "photonvr 0.1.0");
@@ -859,14 +876,15 @@ int runCli(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
-    if (maskCmd->parsed()) return runMask(ma);
+    faultPlan();  // a malformed PVR_INJECT_FAULT is refused before anything runs
+    if (maskCmd->parsed()) return execute ? runMask(ma) : 0;
     if (referenceCmd->parsed()) {
       if (!referenceArgs.settings.empty()) applySettings(referenceArgs.settings, referenceArgs, *referenceCmd);
-      return runReference(referenceArgs, rfa);
+      return execute ? runReference(referenceArgs, rfa) : checkOnly(referenceArgs);
     }
     if (render->parsed()) {
       if (!ra.settings.empty()) applySettings(ra.settings, ra, *render);
-      return runRender(ra);
+      return execute ? runRender(ra) : checkOnly(ra);
     }
     for (auto [cmd, a, l] : {std::tuple{xr, &xa, &xl}, std::tuple{view, &va, &vl}}) {
       if (!cmd->parsed()) continue;
@@ -883,6 +901,7 @@ int runCli(int argc, char** argv) {
       if (l->cudaCopy != "buffer" && l->cudaCopy != "image") throw Error("--cuda-copy must be buffer or image, got '" + l->cudaCopy + "'");
       if (!(l->nearZ > 0.0f) || !std::isfinite(l->nearZ)) throw Error("--near must be a positive number of metres");
       if (!(l->readyTimeout > 0.0) || !std::isfinite(l->readyTimeout)) throw Error("--ready-timeout must be a positive number of seconds");
+      if (!execute) return checkOnly(*a);
       std::unique_ptr<RenderSetup> setup = setUpRender(*a);
       LoopSetup ls;
       ls.backend = setup->backend;
@@ -900,6 +919,7 @@ int runCli(int argc, char** argv) {
         soakArgs.reloadScenes.push_back(reloadScenes.substr(start, comma - start));
         start = comma + 1;
       }
+      if (!execute) return checkOnly(sa);
       std::unique_ptr<RenderSetup> setup = setUpRender(sa);
       LoopSetup ls;
       ls.backend = setup->backend;
@@ -910,6 +930,7 @@ int runCli(int argc, char** argv) {
       return runSoakCommand(soakArgs, ls);
     }
     if (bench->parsed()) {
+      if (!execute) return 0;
       if (fa.suite == "maps") return runMapBench(ba);
       fa.scene = ba.scene;
       fa.k = ba.k;

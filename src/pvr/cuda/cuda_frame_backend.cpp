@@ -9,6 +9,7 @@
 #include "pvr/cuda/denoise.cuh"
 #include "pvr/cuda/display_handover.h"
 #include "pvr/cuda/eye_pass.cuh"
+#include "pvr/cuda/injected_fault.cuh"
 #include "pvr/cuda/photon_map_build.cuh"
 #include "pvr/cuda/photon_trace.cuh"
 #include "pvr/cuda/surface_cache.cuh"
@@ -16,6 +17,7 @@
 #include "pvr/foveation/mask.h"
 #include "pvr/raster/gbuffer_raster.h"
 #include "pvr/scene/scene.h"
+#include "pvr/util/fault_injection.h"
 
 namespace pvr {
 
@@ -221,6 +223,7 @@ void CudaFrameBackend::renderEye(const EyePass& pass) {
   m.frame.width[e] = pass.camera.width, m.frame.height[e] = pass.camera.height;
   m.frame.reused = m.frame.reused || pass.role == StereoRole::Reuser;
   m.frame.cached = m.frame.cached || (pass.density == DensityScheme::SurfaceCache && !pass.foveated());
+  if (faultInjected(Fault::GpuKernelFault)) cuda::launchInjectedFault(m.stream);
   EyePass p = pass;
   if (pass.rasterPrimary) {
     if (!m.frame.rasterised) throw Error("frame pipeline: an eye pass reads rasterised first hits this frame did not make");

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "pvr/cuda/cuda_util.cuh"
+#include "pvr/util/fault_injection.h"
 
 namespace pvr::cuda {
 namespace {
@@ -29,11 +30,34 @@ std::string mib(size_t bytes) {
 
 }  // namespace
 
+// Errors after which the CUDA context is unusable: every later call fails the same way, so the
+// only way on is a clean exit (a new process gets a new context).
+static bool contextLost(cudaError_t error) {
+  switch (error) {
+    case cudaErrorLaunchFailure:
+    case cudaErrorIllegalAddress:
+    case cudaErrorIllegalInstruction:
+    case cudaErrorMisalignedAddress:
+    case cudaErrorInvalidAddressSpace:
+    case cudaErrorInvalidPc:
+    case cudaErrorHardwareStackError:
+    case cudaErrorAssert:
+    case cudaErrorLaunchTimeout:
+    case cudaErrorECCUncorrectable:
+    case cudaErrorDevicesUnavailable:
+    case cudaErrorUnknown: return true;
+    default: return false;
+  }
+}
+
 void throwCudaError(cudaError_t error, const char* what, const char* file, int line) {
   std::string where = std::string(file);
   where = where.substr(where.find_last_of('/') + 1) + ":" + std::to_string(line);
   if (error == cudaErrorMemoryAllocation)
     throw Error(std::string("GPU out of memory (") + what + " at " + where + ")");
+  if (contextLost(error))
+    throw Error(std::string("the GPU device was lost: ") + cudaGetErrorString(error) + " (" + what + " at " + where +
+                "); photonvr cannot continue on this CUDA context");
   throw Error(std::string("CUDA error: ") + cudaGetErrorString(error) + " (" + what + " at " + where + ")");
 }
 
@@ -52,7 +76,7 @@ void* deviceAllocate(size_t bytes, const char* what) {
     throw Error("GPU out of memory: " + std::string(what) + " needs " + mib(bytes) + ", " + mib(gBytesInUse.load()) +
                 " already in use, limit " + mib(limit) + " (PVR_GPU_MEMORY_LIMIT_MB)");
   void* p = nullptr;
-  cudaError_t status = cudaMalloc(&p, bytes);
+  cudaError_t status = faultInjected(Fault::GpuAllocation) ? cudaErrorMemoryAllocation : cudaMalloc(&p, bytes);
   if (status == cudaErrorMemoryAllocation) {
     cudaGetLastError();  // not sticky: clear it so later calls do not report it
     size_t freeBytes = 0, total = 0;

@@ -487,7 +487,7 @@ void GBufferRaster::render(const EyeCamera eyes[2], bool waitForReaders) {
   }
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd;
-  vkCheck(vkQueueSubmit(vk_.queue(), 1, &si, s.fence), "vkQueueSubmit (G-buffer pre-pass)");
+  vkCheck(queueSubmit(vk_.queue(), 1, &si, s.fence), "vkQueueSubmit (G-buffer pre-pass)");
   s.submitted = true;
 }
 

@@ -616,7 +616,7 @@ void ViewerPresenter::present(const PresentedFrame& frame) {
   si.pCommandBuffers = &cmd;
   si.signalSemaphoreCount = windowShot ? 0 : 1;
   si.pSignalSemaphores = &m.renderFinished[index];
-  vkCheck(vkQueueSubmit(m.vk->queue(), 1, &si, m.frameFence), "vkQueueSubmit (window)");
+  vkCheck(queueSubmit(m.vk->queue(), 1, &si, m.frameFence), "vkQueueSubmit (window)");
   VkSemaphore presentWait = m.renderFinished[index];
   if (windowShot) {  // read the window back before it is presented, then hand it on
     vkCheck(vkWaitForFences(m.vk->device(), 1, &m.frameFence, VK_TRUE, 5'000'000'000ull), "vkWaitForFences (window)");

@@ -373,7 +373,7 @@ void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2],
     si.signalSemaphoreCount = 1;
     si.pSignalSemaphores = &signal;
   }
-  vkCheck(vkQueueSubmit(vk_.queue(), 1, &si, slot.fence), "vkQueueSubmit (eye copy)");
+  vkCheck(queueSubmit(vk_.queue(), 1, &si, slot.fence), "vkQueueSubmit (eye copy)");
   slot.submitted = true;
   timestampsValid_ = timestamps_ != VK_NULL_HANDLE;
   last_ = slotIndex;

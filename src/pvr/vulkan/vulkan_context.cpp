@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "pvr/util/error.h"
+#include "pvr/util/fault_injection.h"
 
 namespace pvr {
 
@@ -33,7 +34,16 @@ const char* vkResultName(VkResult r) {
 }
 
 void vkCheck(VkResult result, const char* what) {
+  if (result == VK_ERROR_DEVICE_LOST)
+    throw Error(std::string("Vulkan: ") + what + " failed (VK_ERROR_DEVICE_LOST): the GPU device was lost; photonvr cannot continue on it");
   if (result != VK_SUCCESS) throw Error(std::string("Vulkan: ") + what + " failed (" + vkResultName(result) + ")");
+}
+
+VkResult queueSubmit(VkQueue queue, uint32_t count, const VkSubmitInfo* submits, VkFence fence) {
+  // An injected loss is a submission that failed: none of its work runs, its fence and semaphores
+  // are never signalled, as after a real loss.
+  if (faultInjected(Fault::VulkanDeviceLost)) return VK_ERROR_DEVICE_LOST;
+  return vkQueueSubmit(queue, count, submits, fence);
 }
 
 namespace {
@@ -211,7 +221,7 @@ void VulkanContext::runOnce(const std::function<void(VkCommandBuffer)>& record) 
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
-    vkCheck(vkQueueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
+    vkCheck(queueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
     VkResult r = vkWaitForFences(device_, 1, &fence, VK_TRUE, 10'000'000'000ull);
     if (r == VK_TIMEOUT) throw Error("Vulkan: the GPU did not finish a copy within 10 s");
     vkCheck(r, "vkWaitForFences");
@@ -257,9 +267,10 @@ VkDeviceMemory allocate(const VulkanContext& vk, const VkMemoryRequirements& req
   mai.allocationSize = req.size;
   mai.memoryTypeIndex = vk.memoryType(req.memoryTypeBits, properties);
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  VkResult r = vkAllocateMemory(vk.device(), &mai, nullptr, &memory);
+  VkResult r = faultInjected(Fault::VulkanAllocation) ? VK_ERROR_OUT_OF_DEVICE_MEMORY
+                                                      : vkAllocateMemory(vk.device(), &mai, nullptr, &memory);
   if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
-    throw Error("Vulkan: out of memory for a " + std::to_string(req.size >> 20) + " MiB " + what);
+    throw Error("Vulkan: out of memory for a " + std::to_string((req.size + 1023) >> 10) + " KiB " + what);
   vkCheck(r, "vkAllocateMemory");
   return memory;
 }

@@ -14,6 +14,9 @@ namespace pvr {
 
 // Throws pvr::Error "Vulkan: <what> failed (VK_ERROR_...)" unless result is VK_SUCCESS.
 void vkCheck(VkResult result, const char* what);
+// vkQueueSubmit, every submission of photonvr goes through it (PVR_INJECT_FAULT=vk-device-lost:N
+// makes the Nth answer VK_ERROR_DEVICE_LOST).
+VkResult queueSubmit(VkQueue queue, uint32_t count, const VkSubmitInfo* submits, VkFence fence);
 const char* vkResultName(VkResult result);
 
 // How the instance and device are made: directly, or by someone else (OpenXR's

@@ -1,0 +1,39 @@
+#pragma once
+// Faults provoked on purpose, so that the reliability tests can show what photonvr does when the
+// GPU runs out of memory at any allocation site or the device is lost: PVR_INJECT_FAULT=KIND:N
+// makes the Nth event of KIND fail as the driver would report it (docs/reliability.md).
+//   gpu-alloc       a CUDA device allocation (cudaMalloc answers cudaErrorMemoryAllocation)
+//   gpu-fault       a CUDA frame (a kernel traps before the frame's work: the context is lost,
+//                   cudaErrorLaunchFailure, as after a kernel fault or an Xid)
+//   vk-alloc        a Vulkan memory allocation (VK_ERROR_OUT_OF_DEVICE_MEMORY)
+//   vk-device-lost  a Vulkan queue submission (VK_ERROR_DEVICE_LOST)
+// Unset, a check costs one relaxed atomic increment. The command line reads the variable first, so
+// a malformed value is refused with one line before anything runs.
+#include <cstdint>
+#include <string>
+
+namespace pvr {
+
+enum class Fault { GpuAllocation, GpuKernelFault, VulkanAllocation, VulkanDeviceLost };
+
+struct FaultPlan {
+  bool active = false;
+  Fault kind = Fault::GpuAllocation;
+  uint64_t event = 0;  ///< 1-based
+};
+
+// Parses "KIND:N" (empty: no fault). Throws pvr::Error naming the variable for anything else.
+FaultPlan parseFaultPlan(const std::string& text);
+
+// The plan of PVR_INJECT_FAULT, read once.
+const FaultPlan& faultPlan();
+
+// Counts one event of `kind`; true when this is the one that must fail.
+bool faultInjected(Fault kind);
+
+// How many events of `kind` this process has counted (for the tests' sweeps and their reports).
+uint64_t faultEvents(Fault kind);
+
+const char* faultName(Fault kind);
+
+}  // namespace pvr

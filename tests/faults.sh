@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Faults survived, on the CPU backend and this machine's Vulkan device (lavapipe in CI); the GPU's
+# own faults are tests/gpu_faults.sh. Each fault is provoked by PVR_INJECT_FAULT=KIND:N
+# (src/pvr/util/fault_injection.h) at every event of a run in turn, until a run outlives the
+# last event: each must end with one line on stderr naming the fault, exit code 1, within 60 s.
+#   vk-alloc        every Vulkan memory allocation of the G-buffer pre-pass, the viewer's window
+#                   and the OpenXR hand-over, failing as VK_ERROR_OUT_OF_DEVICE_MEMORY
+#   vk-device-lost  every queue submission of the same runs answering VK_ERROR_DEVICE_LOST
+# Also: a corrupt texture (a warning, the render goes on with the constant colour) and a
+# malformed PVR_INJECT_FAULT.
+#   usage: tests/faults.sh PHOTONVR [FAKE_XR_RUNTIME_JSON]
+set -u
+exe=$1
+xr_json=${2:-}
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+small=(--backend cpu --eye-size 32x36 --photons 32x32)
+printf '0 0.5 2.6 0 0 0 1 0.5 0.5\n0.02 0.5 2.6 0 0.02 0 1 0.5 0.5\n0.04 0.5 2.6 0 0.04 0 1 0.5 0.5\n' >"$out/three.traj"
+
+# sweep NAME KIND EXPECTED-SUBSTRING COMMAND...: the command with the KIND's 1st, 2nd, ... event
+# failing; stops at the first N the command survives (that N - 1 events were each provoked).
+sweep() {
+  local name=$1 kind=$2 expected=$3
+  shift 3
+  local n rc lines
+  for ((n = 1; n <= 200; ++n)); do
+    PVR_INJECT_FAULT=$kind:$n timeout 60 "$@" >"$out/stdout" 2>"$out/stderr"
+    rc=$?
+    # stderr lines other than the failure (the soak's or xr's notes) do not count, warnings do.
+    lines=$(grep -c . "$out/stderr")
+    if [ $rc -eq 0 ]; then
+      if [ $n -eq 1 ]; then fail "$name: no $kind event happened (the run passed with the first one failing)"; return; fi
+      echo "ok   $name: $((n - 1)) $kind event(s), each failing cleanly; e.g. $(cat "$out/first")"
+      return
+    fi
+    if [ $rc -ge 124 ]; then fail "$name: $kind:$n: exit code $rc (a hang or a crash)"; return; fi
+    if [ $rc -ne 1 ] || [ "$lines" -ne 1 ] || ! grep -q -- "$expected" "$out/stderr"; then
+      fail "$name: $kind:$n: exit code $rc, expected one line with '$expected', got: $(cat "$out/stderr")"
+      return
+    fi
+    [ $n -eq 1 ] && cp "$out/stderr" "$out/first"
+  done
+  fail "$name: more than 200 $kind events"
+}
+
+raster=("$exe" render cornell "${small[@]}" --primary raster --trajectory "$out/three.traj" --out "$out/r")
+sweep "raster pre-pass, 3 frames" vk-alloc "Vulkan: out of memory" "${raster[@]}"
+sweep "raster pre-pass, 3 frames" vk-device-lost "VK_ERROR_DEVICE_LOST): the GPU device was lost" "${raster[@]}"
+if command -v xvfb-run >/dev/null; then
+  view=(xvfb-run -a -s "-screen 0 640x480x24" "$exe" view "${small[@]}" --keys 3:Escape)
+  sweep "viewer, 3 frames" vk-alloc "Vulkan: out of memory" "${view[@]}"
+  sweep "viewer, 3 frames" vk-device-lost "VK_ERROR_DEVICE_LOST" "${view[@]}"
+else
+  fail "xvfb-run is not installed (package xvfb)"
+fi
+if [ -n "$xr_json" ]; then
+  xr=(env XR_RUNTIME_JSON="$xr_json" PVR_FAKE_XR=ok "$exe" xr --backend cpu --photons 16x16 --frames 4 --stats "")
+  sweep "OpenXR session, 4 frames" vk-alloc "Vulkan: out of memory" "${xr[@]}"
+  sweep "OpenXR session, 4 frames" vk-device-lost "VK_ERROR_DEVICE_LOST" "${xr[@]}"
+fi
+
+# A corrupt texture: the render goes on, the material keeps its constant colour, one warning.
+"$exe" render cornell --backend cpu --eye-size 16x16 --photons 8x8 --out "$out/tex" >/dev/null 2>&1
+head -c 300 "$out/tex_left.png" >"$out/corrupt.png"
+printf 'newmtl m\nKd 0.8 0.8 0.8\nmap_Kd corrupt.png\n' >"$out/quad.mtl"
+printf 'mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 4/4 3/3 2/2\n' >"$out/quad.obj"
+printf '{"base": "cornell", "meshes": [{"file": "quad.obj", "scale": 0.2, "translate": [0, 0.2, 0]}]}\n' >"$out/corrupt.json"
+"$exe" render "$out/corrupt.json" "${small[@]}" --out "$out/c" >/dev/null 2>"$out/stderr"
+rc=$?
+if [ $rc -ne 0 ] || [ "$(grep -c . "$out/stderr")" -ne 1 ] ||
+   ! grep -q "warning: texture '.*corrupt.png' cannot be read: .*; its material keeps its constant colour" "$out/stderr" ||
+   [ ! -s "$out/c_left.png" ]; then
+  fail "corrupt texture: exit code $rc, stderr: $(cat "$out/stderr")"
+else
+  echo "ok   corrupt texture: $(cat "$out/stderr")"
+fi
+
+# A malformed fault plan is refused before anything runs.
+for bad in "gpu-alloc" "gpu-alloc:0" "gpu-alloc:x" "disk-full:1" "vk-alloc:-1"; do
+  PVR_INJECT_FAULT=$bad "$exe" render cornell "${small[@]}" --out "$out/b" >/dev/null 2>"$out/stderr"
+  rc=$?
+  if [ $rc -ne 1 ] || [ "$(grep -c . "$out/stderr")" -ne 1 ] || ! grep -q "PVR_INJECT_FAULT must be KIND:N" "$out/stderr"; then
+    fail "PVR_INJECT_FAULT=$bad: exit code $rc, stderr: $(cat "$out/stderr")"
+  fi
+done
+echo "ok   malformed PVR_INJECT_FAULT values refused with one line"
+
+[ $failures -eq 0 ] && echo "all fault cases passed" || echo "$failures fault case(s) failed"
+exit $((failures > 0))

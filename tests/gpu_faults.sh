@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# Faults survived on the CUDA backend (the CPU and Vulkan ones are tests/faults.sh). Each fault is
+# provoked by PVR_INJECT_FAULT=KIND:N (src/pvr/util/fault_injection.h) at every event of a run in
+# turn, until a run outlives the last event; each must end with one line on stderr naming the
+# fault, exit code 1, within 60 s (no hang):
+#   gpu-alloc       every CUDA allocation of runs that between them reach every allocation site
+#                   (photon buffers, maps, eye buffers, reuse, TAA, the denoiser, the rolling map,
+#                   the surface cache, foveation, kd-tree/kNN, textures, the pre-pass's import,
+#                   the offscreen loop's hand-over), failing as cudaErrorMemoryAllocation
+#   gpu-fault       every eye pass of those runs starting with a kernel that traps: the context
+#                   is lost (cudaErrorLaunchFailure, as after a kernel fault or an Xid)
+#   vk-device-lost  every Vulkan submission of the pre-pass that shares memory with CUDA
+# Prints the allocation sites each sweep reached. Exits 77 (skipped) where no CUDA GPU is present.
+#   usage: tests/gpu_faults.sh PHOTONVR DATA_DIR
+set -u
+exe=$1
+data=$2
+top=$(mktemp -d)
+trap 'rm -rf "$top"' EXIT
+out=$top
+if ! "$exe" render --backend cuda --eye-size 8x8 --photons 8x8 --out "$out/probe" >/dev/null 2>&1; then
+  echo "no CUDA GPU: skipped"
+  exit 77
+fi
+fail() { echo "FAIL: $*"; }
+small=(--backend cuda --eye-size 96x104 --photons 64x64)
+traj=(--trajectory "$data/gaze_pursuit.traj")
+
+# Each sweep runs in the background in its own folder (the GPU and 16 cores take them at once).
+sweep() {  # name kind expected-substring command...
+  local name=$1 kind=$2 expected=$3
+  shift 3
+  local n rc start
+  local out
+  out=$(mktemp -d -p "$top")
+  : >"$out/sites"
+  : >"$out/secs"
+  for ((n = 1; n <= 400; ++n)); do
+    start=$SECONDS
+    PVR_INJECT_FAULT=$kind:$n timeout 60 "$@" >"$out/stdout" 2>"$out/stderr"
+    rc=$?
+    if [ $rc -eq 0 ]; then
+      if [ $n -eq 1 ]; then fail "$name: no $kind event happened"; return; fi
+      echo "ok   $name: $((n - 1)) $kind event(s), each one line and exit 1 (slowest $(sort -n "$out/secs" | tail -1) s)"
+      [ -s "$out/sites" ] && sort "$out/sites" | uniq -c | sed 's/^/       /'
+      return
+    fi
+    echo $((SECONDS - start)) >>"$out/secs"
+    if [ $rc -ge 124 ]; then fail "$name: $kind:$n: exit code $rc (a hang or a crash): $(cat "$out/stderr")"; return; fi
+    if [ $rc -ne 1 ] || [ "$(grep -c . "$out/stderr")" -ne 1 ] || ! grep -q -- "$expected" "$out/stderr"; then
+      fail "$name: $kind:$n: exit code $rc, expected one line with '$expected', got: $(cat "$out/stderr")"
+      return
+    fi
+    # The allocation's label: "GPU out of memory: LABEL needs ..."
+    sed -n 's/.*GPU out of memory: \(.*\) needs .*/\1/p' "$out/stderr" >>"$out/sites"
+  done
+  fail "$name: more than 400 $kind events"
+}
+
+logs=()
+runs=(
+  "scatter+TAA|render cornell-caustics ${small[*]} --stereo scatter --kernel shared --taa ${traj[*]} --out $out/a"
+  "denoised+rolling|render cornell ${small[*]} --denoise --photon-batches 4 --stereo gather ${traj[*]} --out $out/b"
+  "textures+cache|render $data/textured_box.json ${small[*]} --density cache --stereo gather --out $out/c"
+  "foveated+sorted|render cornell ${small[*]} --foveated --stereo gather --kernel sorted ${traj[*]} --out $out/d"
+  "kd-tree+kNN|render cornell ${small[*]} --map kdtree --estimator knn --kernel single --out $out/e"
+  "pre-pass+path|render cornell-caustics ${small[*]} --primary raster --effects path --stereo gather ${traj[*]} --out $out/f"
+  "offscreen loop|xr --offscreen ${small[*]} --frames 6 --stats $out/g.json"
+)
+for entry in "${runs[@]}"; do
+  name=${entry%%|*}
+  read -r -a args <<<"${entry#*|}"
+  i=${#logs[@]}
+  sweep "$name" gpu-alloc "GPU out of memory" "$exe" "${args[@]}" >"$top/log$i" 2>&1 &
+  sweep "$name" gpu-fault "the GPU device was lost" "$exe" "${args[@]}" >"$top/log$((i + 1))" 2>&1 &
+  logs+=("$top/log$i" "$top/log$((i + 1))")
+done
+read -r -a args <<<"render cornell-caustics ${small[*]} --primary raster --stereo gather ${traj[*]} --out $out/h"
+i=${#logs[@]}
+sweep "pre-pass shared with CUDA" vk-device-lost "VK_ERROR_DEVICE_LOST" "$exe" "${args[@]}" >"$top/log$i" 2>&1 &
+sweep "pre-pass shared with CUDA" vk-alloc "Vulkan: out of memory" "$exe" "${args[@]}" >"$top/log$((i + 1))" 2>&1 &
+logs+=("$top/log$i" "$top/log$((i + 1))")
+wait
+cat "${logs[@]}"
+failures=$(cat "${logs[@]}" | grep -c '^FAIL')
+[ "$failures" -eq 0 ] && echo "all GPU fault cases passed" || echo "$failures GPU fault case(s) failed"
+exit $((failures > 0))
