@@ -24,6 +24,12 @@ if ! "$exe" render --backend cuda --eye-size 8x8 --photons 8x8 --out "$out/probe
 fi
 fail() { echo "FAIL: $*"; }
 small=(--backend cuda --eye-size 96x104 --photons 64x64)
+# A textured quad in the Cornell box (its texture: a PNG photonvr renders), so that textures are
+# uploaded without test models installed.
+"$exe" render cornell --backend cpu --eye-size 16x16 --photons 8x8 --out "$out/tex" >/dev/null 2>&1
+printf 'newmtl m\nKd 0.8 0.8 0.8\nmap_Kd tex_left.png\n' >"$out/quad.mtl"
+printf 'mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 4/4 3/3 2/2\n' >"$out/quad.obj"
+printf '{"base": "cornell", "meshes": [{"file": "quad.obj", "scale": 0.2, "translate": [0, 0.2, 0]}]}\n' >"$out/textured.json"
 traj=(--trajectory "$data/gaze_pursuit.traj")
 
 # Each sweep runs in the background in its own folder (the GPU and 16 cores take them at once).
@@ -61,7 +67,7 @@ logs=()
 runs=(
   "scatter+TAA|render cornell-caustics ${small[*]} --stereo scatter --kernel shared --taa ${traj[*]} --out $out/a"
   "denoised+rolling|render cornell ${small[*]} --denoise --photon-batches 4 --stereo gather ${traj[*]} --out $out/b"
-  "textures+cache|render $data/textured_box.json ${small[*]} --density cache --stereo gather --out $out/c"
+  "textures+cache|render $out/textured.json ${small[*]} --density cache --stereo gather --out $out/c"
   "foveated+sorted|render cornell ${small[*]} --foveated --stereo gather --kernel sorted ${traj[*]} --out $out/d"
   "kd-tree+kNN|render cornell ${small[*]} --map kdtree --estimator knn --kernel single --out $out/e"
   "pre-pass+path|render cornell-caustics ${small[*]} --primary raster --effects path --stereo gather ${traj[*]} --out $out/f"

@@ -50,21 +50,25 @@ static bool contextLost(cudaError_t error) {
   }
 }
 
+// One line for the user: out of memory, a lost context, or any other CUDA error, with where.
+[[noreturn]] static void throwCudaStatus(cudaError_t error, const std::string& where) {
+  if (error == cudaErrorMemoryAllocation) throw Error("GPU out of memory (" + where + ")");
+  if (contextLost(error))
+    throw Error(std::string("the GPU device was lost: ") + cudaGetErrorString(error) + " (" + where +
+                "); photonvr cannot continue on this CUDA context");
+  throw Error(std::string("CUDA error: ") + cudaGetErrorString(error) + " (" + where + ")");
+}
+
 void throwCudaError(cudaError_t error, const char* what, const char* file, int line) {
   std::string where = std::string(file);
   where = where.substr(where.find_last_of('/') + 1) + ":" + std::to_string(line);
-  if (error == cudaErrorMemoryAllocation)
-    throw Error(std::string("GPU out of memory (") + what + " at " + where + ")");
-  if (contextLost(error))
-    throw Error(std::string("the GPU device was lost: ") + cudaGetErrorString(error) + " (" + what + " at " + where +
-                "); photonvr cannot continue on this CUDA context");
-  throw Error(std::string("CUDA error: ") + cudaGetErrorString(error) + " (" + what + " at " + where + ")");
+  throwCudaStatus(error, std::string(what) + " at " + where);
 }
 
 void throwLaunchError(cudaError_t error, const char* label) {
-  cudaGetLastError();  // a launch error is not sticky
-  if (error == cudaErrorMemoryAllocation) throw Error(std::string("GPU out of memory launching the ") + label + " kernel");
-  throw Error(std::string("CUDA error: ") + cudaGetErrorString(error) + " (launching the " + label + " kernel)");
+  cudaGetLastError();  // a launch error is not sticky (a lost context's is, and stays)
+  // A fault of an earlier kernel can surface at this launch: the context is then lost.
+  throwCudaStatus(error, std::string("launching the ") + label + " kernel");
 }
 
 size_t deviceBytesInUse() { return gBytesInUse.load(); }
