@@ -30,9 +30,11 @@ small=(--backend cuda --eye-size 96x104 --photons 64x64)
 printf 'newmtl m\nKd 0.8 0.8 0.8\nmap_Kd tex_left.png\n' >"$out/quad.mtl"
 printf 'mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 4/4 3/3 2/2\n' >"$out/quad.obj"
 printf '{"base": "cornell", "meshes": [{"file": "quad.obj", "scale": 0.2, "translate": [0, 0.2, 0]}]}\n' >"$out/textured.json"
-traj=(--trajectory "$data/gaze_pursuit.traj")
+printf '0 0.5 2.6 0 0 0 1 0.4 0.5\n0.02 0.5 2.6 0 0.02 0 1 0.5 0.5\n0.04 0.5 2.6 0 0.04 0 1 0.6 0.5\n' >"$out/three.traj"
+traj=(--trajectory "$out/three.traj")
 
-# Each sweep runs in the background in its own folder (the GPU and 16 cores take them at once).
+# Each sweep runs in the background in its own folder (the GPU and 16 cores take them at once) and
+# prints its result in one write as soon as it ends, so a run cut short still shows what ended.
 sweep() {  # name kind expected-substring command...
   local name=$1 kind=$2 expected=$3
   shift 3
@@ -47,8 +49,8 @@ sweep() {  # name kind expected-substring command...
     rc=$?
     if [ $rc -eq 0 ]; then
       if [ $n -eq 1 ]; then fail "$name: no $kind event happened"; return; fi
-      echo "ok   $name: $((n - 1)) $kind event(s), each one line and exit 1 (slowest $(sort -n "$out/secs" | tail -1) s)"
-      [ -s "$out/sites" ] && sort "$out/sites" | uniq -c | sed 's/^/       /'
+      printf '%s\n%s\n' "ok   $name: $((n - 1)) $kind event(s), each one line and exit 1 (slowest $(sort -n "$out/secs" | tail -1) s)" \
+        "$(sort "$out/sites" | uniq -c | sed 's/^ */       /')"
       return
     fi
     echo $((SECONDS - start)) >>"$out/secs"
@@ -63,7 +65,6 @@ sweep() {  # name kind expected-substring command...
   fail "$name: more than 400 $kind events"
 }
 
-logs=()
 runs=(
   "scatter+TAA|render cornell-caustics ${small[*]} --stereo scatter --kernel shared --taa ${traj[*]} --out $out/a"
   "denoised+rolling|render cornell ${small[*]} --denoise --photon-batches 4 --stereo gather ${traj[*]} --out $out/b"
@@ -76,18 +77,13 @@ runs=(
 for entry in "${runs[@]}"; do
   name=${entry%%|*}
   read -r -a args <<<"${entry#*|}"
-  i=${#logs[@]}
-  sweep "$name" gpu-alloc "GPU out of memory" "$exe" "${args[@]}" >"$top/log$i" 2>&1 &
-  sweep "$name" gpu-fault "the GPU device was lost" "$exe" "${args[@]}" >"$top/log$((i + 1))" 2>&1 &
-  logs+=("$top/log$i" "$top/log$((i + 1))")
+  sweep "$name" gpu-alloc "GPU out of memory" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
+  sweep "$name" gpu-fault "the GPU device was lost" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
 done
 read -r -a args <<<"render cornell-caustics ${small[*]} --primary raster --stereo gather ${traj[*]} --out $out/h"
-i=${#logs[@]}
-sweep "pre-pass shared with CUDA" vk-device-lost "VK_ERROR_DEVICE_LOST" "$exe" "${args[@]}" >"$top/log$i" 2>&1 &
-sweep "pre-pass shared with CUDA" vk-alloc "Vulkan: out of memory" "$exe" "${args[@]}" >"$top/log$((i + 1))" 2>&1 &
-logs+=("$top/log$i" "$top/log$((i + 1))")
+sweep "pre-pass shared with CUDA" vk-device-lost "VK_ERROR_DEVICE_LOST" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
+sweep "pre-pass shared with CUDA" vk-alloc "Vulkan: out of memory" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
 wait
-cat "${logs[@]}"
-failures=$(cat "${logs[@]}" | grep -c '^FAIL')
+failures=$(grep -c '^FAIL' "$top/results")
 [ "$failures" -eq 0 ] && echo "all GPU fault cases passed" || echo "$failures GPU fault case(s) failed"
 exit $((failures > 0))
