@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "pvr/loop/frame_loop.h"
+#include "pvr/loop/loop_keys.h"
 #include "pvr/loop/offscreen_presenter.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
@@ -136,6 +137,34 @@ TEST(OffscreenPresenter, RejectsABadRefreshRate) {
     oo.refreshHz = hz;
     EXPECT_THROW(OffscreenPresenter(defaultRig(), {}, oo), Error);
   }
+}
+
+// xr's keys: 1-5 put every material at one level, e steps through them, 0 gives the scene's own
+// levels back, anything else changes nothing.
+TEST(LoopKeys, EffectLevelKeys) {
+  RenderOptions o;
+  ASSERT_FALSE(o.gather.overrideEffects);
+  const RenderOptions before = o;
+  for (char key : {'x', '\n', '6', ' ', 'E'}) {
+    EXPECT_EQ(applyLoopKey(key, o), "") << int(key);
+    EXPECT_FALSE(o.gather.overrideEffects);
+    EXPECT_EQ(o.gather.effects, before.gather.effects);
+  }
+  const char* names[] = {"raster", "shadows", "reflections", "gi", "path"};
+  for (int level = 0; level < kEffectLevels; ++level) {
+    EXPECT_EQ(applyLoopKey(char('1' + level), o), std::string("every material at ") + names[level]);
+    EXPECT_TRUE(o.gather.overrideEffects);
+    EXPECT_EQ(o.gather.effects, EffectLevel(level));
+  }
+  // From path, e wraps to raster and steps up one level a key.
+  for (int step = 0; step < 2 * kEffectLevels; ++step) {
+    const int expected = step % kEffectLevels;
+    EXPECT_EQ(applyLoopKey('e', o), std::string("every material at ") + names[expected]);
+    EXPECT_EQ(o.gather.effects, EffectLevel(expected));
+  }
+  EXPECT_EQ(applyLoopKey('0', o), "each material at its own level");
+  EXPECT_FALSE(o.gather.overrideEffects);
+  EXPECT_EQ(applyLoopKey('e', o), "every material at raster");  // from the scene's own levels: the first
 }
 
 }  // namespace

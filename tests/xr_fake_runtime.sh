@@ -23,6 +23,21 @@ else
   echo "ok   (a session of 12 frames at the runtime's 64x48, depth layer, ended in EXITING)"
 fi
 
+# Keys during a session (piped with --stdin-keys, one a frame): 2, e, then 0, each reported once in
+# that order; the run ends at the scene's own levels.
+printf '2\ne0' | PVR_FAKE_XR=ok timeout 120 "$exe" xr "${small[@]}" --frames 8 --stdin-keys --stats "$out/keys.json" \
+  >"$out/keys.log" 2>"$out/keys.err"
+rc=$?
+keys=$(grep -o "key '.*" "$out/keys.log" | tr '\n' '|')
+if [ $rc -ne 0 ] || [ -s "$out/keys.err" ] ||
+   [ "$keys" != "key '2': every material at shadows|key 'e': every material at reflections|key '0': each material at its own level|" ] ||
+   ! tr -d ' \n' <"$out/keys.json" | grep -q '"effects":"permaterial"'; then
+  echo "FAIL (keys): exit $rc, keys '$keys', stderr: $(cat "$out/keys.err")"
+  failures=$((failures + 1))
+else
+  echo "ok   (keys 2, e, 0 applied on successive frames: shadows, reflections, the scene's own levels)"
+fi
+
 expect_error() {  # mode, expected-substring, extra arguments...
   local mode=$1 expected=$2
   shift 2

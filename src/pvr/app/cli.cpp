@@ -773,6 +773,9 @@ int runCli(int argc, char** argv, CliRun run) {
                  "image-to-image copy)")
       ->capture_default_str();
   xr->add_flag("--paced", xl.paced, "Offscreen: wait for each display slot as vsync would");
+  xr->add_flag("--stdin-keys", xl.stdinKeys,
+               "Read keys from standard input even when it is not a terminal (a terminal always gives keys): 1-5 put "
+               "every material at raster, shadows, reflections, gi or path, e the next level, 0 the scene's own");
   xr->add_flag("--stage", xl.stage, "STAGE reference space (floor origin) instead of LOCAL (the head at start)");
   xr->add_flag("!--no-depth", xl.depthLayer, "Do not submit a depth layer");
   xr->add_option("--near", xl.nearZ, "Metres at depth 1 of the depth layer (reversed Z, infinite far)")->capture_default_str();

@@ -12,6 +12,7 @@
 
 #include "pvr/foveation/mask.h"
 #include "pvr/loop/frame_loop.h"
+#include "pvr/loop/loop_keys.h"
 #include "pvr/loop/offscreen_presenter.h"
 #include "pvr/util/error.h"
 #include "pvr/viewer/viewer_presenter.h"
@@ -120,6 +121,18 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
   std::optional<FoveationMask> mask;
   nlohmann::json run;
   FrameStats stats;
+  // Keys change the effect levels while the loop runs: from a terminal, or piped with --stdin-keys.
+  std::optional<TerminalKeys> keys;
+  if (args.stdinKeys || TerminalKeys::standardInputIsTerminal()) {
+    keys.emplace();
+    std::printf("xr: keys 1-5 put every material at raster, shadows, reflections, gi or path; e the next level; "
+                "0 the scene's own levels\n");
+  }
+  auto runLoop = [&](Presenter& presenter) {
+    if (!keys) return FrameLoop(renderer, presenter).run(lo);
+    KeyedPresenter keyed(presenter, *keys, "xr");
+    return FrameLoop(renderer, keyed).run(lo);
+  };
   if (args.offscreen) {
     std::unique_ptr<VulkanContext> vk;
     std::unique_ptr<EyeTransfer> transfer;
@@ -183,7 +196,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::unique_ptr<BudgetController> controller = makeBudgetController(
         args.budgetMs, args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
-    stats = FrameLoop(renderer, presenter).run(lo);
+    stats = runLoop(presenter);
     auto skipWarmup = [&](std::vector<double> v) {
       if (v.size() > args.warmup) v.erase(v.begin(), v.begin() + long(args.warmup));
       return latencyStats(v);
@@ -230,7 +243,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::unique_ptr<BudgetController> controller = makeBudgetController(
         args.budgetMs, args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
-    stats = FrameLoop(renderer, presenter).run(lo);
+    stats = runLoop(presenter);
     run["presenter"] = "openxr";
     run["runtime"] = info.runtime;
     run["system"] = info.system;

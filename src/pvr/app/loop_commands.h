@@ -29,6 +29,7 @@ struct LoopCommandArgs {
   float nearZ = 0.05f;
   double readyTimeout = 10.0;
   bool eyeSizeGiven = false;     ///< xr: --eye-size overrides the runtime's recommended size
+  bool stdinKeys = false;        ///< xr: read keys (pvr/loop/loop_keys.h) from standard input even when it is no terminal
   float exposure = 1.0f;
   // view
   std::string screenshot = "out/view";
