@@ -29,7 +29,8 @@ TEST(FaultPlan, ParsesEachKindAndItsEvent) {
 
 TEST(FaultPlan, RefusesMalformedPlans) {
   for (const char* bad : {"gpu-alloc", "gpu-alloc:", "gpu-alloc:0", "gpu-alloc:-3", "gpu-alloc:2x", "GPU-ALLOC:1",
-                          "disk-full:1", ":1", "gpu-alloc:1:2"}) {
+                          "disk-full:1", ":1", "gpu-alloc:1:2", "gpu-alloc: 5", "gpu-alloc:+5",
+                          "gpu-alloc:99999999999999999999"}) {
     try {
       parseFaultPlan(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";
@@ -45,6 +46,7 @@ TEST(FaultPlan, WithoutAPlanEventsAreCountedAndNoneFails) {
   const uint64_t before = faultEvents(Fault::VulkanDeviceLost);
   for (int i = 0; i < 5; ++i) EXPECT_FALSE(faultInjected(Fault::VulkanDeviceLost));
   EXPECT_EQ(faultEvents(Fault::VulkanDeviceLost), before + 5);
+  EXPECT_EQ(faultPlanReport(), "");
 }
 
 }  // namespace

@@ -18,9 +18,13 @@ data=$2
 top=$(mktemp -d)
 trap 'rm -rf "$top"' EXIT
 out=$top
-if ! "$exe" render --backend cuda --eye-size 8x8 --photons 8x8 --out "$out/probe" >/dev/null 2>&1; then
-  echo "no CUDA GPU: skipped"
-  exit 77
+if ! "$exe" render --backend cuda --eye-size 8x8 --photons 8x8 --out "$out/probe" >/dev/null 2>"$out/probe.err"; then
+  if grep -q "^photonvr: error: --backend cuda: no" "$out/probe.err"; then
+    echo "no CUDA GPU: skipped ($(cat "$out/probe.err"))"
+    exit 77
+  fi
+  echo "FAIL: the CUDA probe render failed: $(cat "$out/probe.err")"
+  exit 1
 fi
 fail() { echo "FAIL: $*"; }
 small=(--backend cuda --eye-size 96x104 --photons 64x64)
@@ -48,6 +52,12 @@ sweep() {  # name kind expected-substring command...
     PVR_INJECT_FAULT=$kind:$n timeout 60 "$@" >"$out/stdout" 2>"$out/stderr"
     rc=$?
     if [ $rc -eq 0 ]; then
+      # The run outlived the plan: it must say that the planned event did not happen (else the
+      # fault was swallowed) and count the events the sweep made fail.
+      if ! grep -q "fault plan $kind:$n: $((n - 1)) $kind events, the planned one did not happen" "$out/stderr"; then
+        fail "$name: $kind:$n: the run went on: $(cat "$out/stderr")"
+        return
+      fi
       if [ $n -eq 1 ]; then fail "$name: no $kind event happened"; return; fi
       printf '%s\n%s\n' "ok   $name: $((n - 1)) $kind event(s), each one line and exit 1 (slowest $(sort -n "$out/secs" | tail -1) s)" \
         "$(sort "$out/sites" | uniq -c | sed 's/^ */       /')"
@@ -76,9 +86,11 @@ runs=(
 )
 for entry in "${runs[@]}"; do
   name=${entry%%|*}
-  read -r -a args <<<"${entry#*|}"
-  sweep "$name" gpu-alloc "GPU out of memory" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
-  sweep "$name" gpu-fault "the GPU device was lost" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
+  # The two sweeps of a run at once: each writes its own images and statistics.
+  read -r -a alloc <<<"${entry#*|}"
+  read -r -a fault <<<"$(sed -e "s|--out $out/|--out $out/fault-|" -e "s|--stats $out/|--stats $out/fault-|" <<<"${entry#*|}")"
+  sweep "$name" gpu-alloc "GPU out of memory" "$exe" "${alloc[@]}" 2>&1 | tee -a "$top/results" &
+  sweep "$name" gpu-fault "the GPU device was lost" "$exe" "${fault[@]}" 2>&1 | tee -a "$top/results" &
 done
 read -r -a args <<<"render cornell-caustics ${small[*]} --primary raster --stereo gather ${traj[*]} --out $out/h"
 sweep "pre-pass shared with CUDA" vk-device-lost "VK_ERROR_DEVICE_LOST" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &

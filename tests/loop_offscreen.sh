@@ -20,7 +20,7 @@ grep -q '"cpu_ms":{"max":[0-9.e-]*,"mean":[0-9.e-]*,"p50":[0-9.e-]*,"p99":[0-9.e
 grep -q '"handover_ms":{' "$out/flat" || fail "no hand-over timing"
 # A key piped in (--stdin-keys): every material at the path level from the first frame on.
 printf '5' | "$exe" xr --offscreen --backend cpu --eye-size 48x40 --photons 32x32 --frames 3 --refresh 1 --handover none \
-  --stdin-keys --stats "$out/keys.json" >"$out/log" 2>&1 || { cat "$out/log"; fail "exit code $? with --stdin-keys"; }
+  --stdin-keys --stats "$out/keys.json" >"$out/log" 2>&1 || { rc=$?; cat "$out/log"; fail "exit code $rc with --stdin-keys"; }
 grep -q "xr: frame 0: key '5': every material at path" "$out/log" || { cat "$out/log"; fail "key 5 not applied at frame 0"; }
 tr -d ' \n' <"$out/keys.json" | grep -q '"effects":"path"' || fail "the statistics do not show the path level"
 # Under the budget controller: its decisions in the statistics, a summary line, no frame lost

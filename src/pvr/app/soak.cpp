@@ -19,6 +19,17 @@
 #include "pvr/util/latency_stats.h"
 #include "pvr/vulkan/vulkan_context.h"
 
+#if defined(__SANITIZE_ADDRESS__)
+#define PVR_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PVR_ASAN 1
+#endif
+#endif
+#ifdef PVR_ASAN
+#include <sanitizer/allocator_interface.h>
+#endif
+
 namespace pvr {
 namespace {
 
@@ -35,8 +46,12 @@ size_t residentBytes() {
 // unlike the resident set it does not move with fragmentation or an allocator's high-water mark,
 // so a leak shows as growth here and a new high-water mark does not.
 size_t heapBytesInUse() {
+#ifdef PVR_ASAN
+  return __sanitizer_get_current_allocated_bytes();  // ASan's allocator: glibc's heap is not used
+#else
   const struct mallinfo2 m = mallinfo2();
   return m.uordblks + m.hblkhd;
+#endif
 }
 
 int openFileDescriptors() {
@@ -213,6 +228,20 @@ int runSoakCommand(const SoakArgs& args, const LoopSetup& setup) {
   if (!(args.maxRssGrowthMiB >= 0.0) || !std::isfinite(args.maxRssGrowthMiB))
     throw Error("--max-rss-growth must be a non-negative number of MiB");
   if (!(args.maxP99Ratio >= 0.0) || !std::isfinite(args.maxP99Ratio)) throw Error("--max-p99-ratio must be a non-negative number");
+  // The warm-up is the first cycle and, with reloads, the first load of each scene the reloads
+  // cycle through (each new scene brings its own buffer sizes and allocator high-water marks
+  // once). Memory is compared between samples a round of reloads apart (the same scene at the
+  // same point of the cycle): the run must hold such a pair after the warm-up.
+  const uint64_t reloadScenes = args.reloadScenes.empty() ? 1 : args.reloadScenes.size();
+  const uint64_t round = reloadEvery < args.frames ? reloadEvery * reloadScenes : cycle;
+  const uint64_t lastFrame = args.frames / cycle * cycle;
+  uint64_t warmup = cycle;
+  if (reloadEvery < args.frames) warmup = std::max(warmup, reloadEvery * reloadScenes + cycle);
+  if (warmup + round > lastFrame) warmup = cycle;  // too short a run for that: the first cycle
+  if (warmup + round > lastFrame)
+    throw Error("--frames: the memory checks compare samples a round of reloads apart (" + std::to_string(round) +
+                " frames) after the warm-up (" + std::to_string(warmup) + "): at least " + std::to_string(warmup + round) +
+                " frames");
 
   // The raster pre-pass state needs a Vulkan device.
   bool raster = true;
@@ -293,13 +322,7 @@ int runSoakCommand(const SoakArgs& args, const LoopSetup& setup) {
     }
   }
 
-  // Checks over the samples after the warm-up (each at the same point of the cycle). The warm-up
-  // is the first cycle and, with reloads, the first load of each scene the reloads cycle through
-  // (each new scene brings its own buffer sizes and allocator high-water marks once).
-  const uint64_t reloadScenes = args.reloadScenes.empty() ? 1 : args.reloadScenes.size();
-  uint64_t warmup = cycle;
-  if (reloadEvery < args.frames) warmup = std::max(warmup, reloadEvery * reloadScenes + cycle);
-  if (warmup + 2 * cycle > args.frames) warmup = cycle;  // too short a run for that: the first cycle
+  // Checks over the samples after the warm-up (each at the end of a cycle).
   std::vector<double> x, rss, heap;
   int fdsMin = 1 << 30, fdsMax = 0;
   size_t trackedMin = ~size_t(0), trackedMax = 0, usedMin = ~size_t(0), usedMax = 0;
@@ -317,11 +340,12 @@ int runSoakCommand(const SoakArgs& args, const LoopSetup& setup) {
   // Growth from the first sample after the warm-up to the last, two samples at the same point of
   // the reloads' round (each scene has its own sizes, so a slope across them would see the
   // alternation): a leak grows it, a scene's size or one allocator high-water mark does not.
-  const uint64_t round = reloadEvery < args.frames ? reloadEvery * reloadScenes : cycle;
+  // The argument checks made sure that such a first sample exists and is not the last.
   const Sample& lastSample = samples.back();
+  auto samePhase = [&](uint64_t frame) { return frame <= lastSample.frame && (lastSample.frame - frame) % round == 0; };
   const Sample* firstSample = &lastSample;
   for (const Sample& s : samples)
-    if (s.frame >= warmup && (lastSample.frame - s.frame) % round == 0) {
+    if (s.frame >= warmup && samePhase(s.frame)) {
       firstSample = &s;
       break;
     }
@@ -330,12 +354,13 @@ int runSoakCommand(const SoakArgs& args, const LoopSetup& setup) {
   const uint64_t span = lastSample.frame - firstSample->frame;
   // p99 of the first cycle after the warm-up cycle against the last, taking the first at the same
   // point of the reloads' round as the last (the same scene: scenes differ in cost).
-  size_t firstWindow = windows.size() - 1;
-  for (size_t w = 1; w < windows.size(); ++w)
-    if ((lastSample.frame - (w + 1) * cycle) % round == 0) {
+  size_t firstWindow = windows.size() - 1;  // none: the last against itself, reported as not compared
+  for (size_t w = 1; w + 1 < windows.size(); ++w)
+    if (w * cycle >= warmup && samePhase((w + 1) * cycle)) {
       firstWindow = w;
       break;
     }
+  const bool p99Compared = firstWindow + 1 < windows.size();
   const LatencyStats first = windows[firstWindow];
   const LatencyStats last = windows.back();
   const double p99Ratio = first.p99 > 0 ? last.p99 / first.p99 : 0.0;
@@ -361,25 +386,27 @@ int runSoakCommand(const SoakArgs& args, const LoopSetup& setup) {
   check("live heap flat after warm-up (growth <= 1 MiB)", heapGrowth <= 1024.0 * 1024.0, buf);
   std::snprintf(buf, sizeof buf, "%d .. %d", fdsMin, fdsMax);
   check("open file descriptors constant after warm-up", fdsMin == fdsMax, buf);
-  // GPU memory: each sample after the warm-up against the one a round of reloads before it (the
-  // same scene at the same point of the options' cycle), so that the scenes' own sizes cancel.
+  // GPU memory: every sample after the warm-up at the first sample's point of the round (the same
+  // scene at the same point of the options' cycle) against that first one, so that the scenes'
+  // own sizes cancel and a slow leak adds up.
   double trackedChange = 0, usedChange = 0;
-  for (size_t i = 0; i < samples.size(); ++i)
-    for (size_t j = 0; j < i; ++j)
-      if (samples[j].frame >= warmup && samples[i].frame - samples[j].frame == round) {
-        trackedChange = std::max(trackedChange, std::abs(double(samples[i].gpuTracked) - double(samples[j].gpuTracked)));
-        usedChange = std::max(usedChange, std::abs(double(samples[i].gpuUsed) - double(samples[j].gpuUsed)));
-      }
-  std::snprintf(buf, sizeof buf, "%.3f .. %.3f MiB over all scenes; at most %.3f MiB of change a round", mib(double(trackedMin)),
-                mib(double(trackedMax)), mib(trackedChange));
+  for (const Sample& s : samples)
+    if (s.frame > firstSample->frame && samePhase(s.frame)) {
+      trackedChange = std::max(trackedChange, std::abs(double(s.gpuTracked) - double(firstSample->gpuTracked)));
+      usedChange = std::max(usedChange, std::abs(double(s.gpuUsed) - double(firstSample->gpuUsed)));
+    }
+  std::snprintf(buf, sizeof buf, "%.3f .. %.3f MiB over all scenes; at most %.3f MiB from frame %llu's", mib(double(trackedMin)),
+                mib(double(trackedMax)), mib(trackedChange), (unsigned long long)firstSample->frame);
   check("GPU memory held by the renderer constant after warm-up", trackedChange == 0.0, buf);
-  std::snprintf(buf, sizeof buf, "%.1f .. %.1f MiB over all scenes; at most %.2f MiB of change a round", mib(double(usedMin)),
-                mib(double(usedMax)), mib(usedChange));
+  std::snprintf(buf, sizeof buf, "%.1f .. %.1f MiB over all scenes; at most %.2f MiB from frame %llu's", mib(double(usedMin)),
+                mib(double(usedMax)), mib(usedChange), (unsigned long long)firstSample->frame);
   check("GPU memory in use on the device flat after warm-up (within 2 MiB)", usedChange <= double(size_t(2) << 20), buf);
   std::snprintf(buf, sizeof buf, "p99 %.2f ms (frames %llu-%llu), %.2f ms (last %llu), ratio %.3f", first.p99,
                 (unsigned long long)(firstWindow * cycle), (unsigned long long)((firstWindow + 1) * cycle), last.p99,
                 (unsigned long long)cycle, p99Ratio);
-  if (args.maxP99Ratio > 0)
+  if (!p99Compared)
+    std::printf("soak: p99 not compared: no cycle after the warm-up at the last one's point of the reloads' round\n");
+  else if (args.maxP99Ratio > 0)
     check("p99 steady (last window over first <= " + std::to_string(args.maxP99Ratio).substr(0, 4) + ")", p99Ratio <= args.maxP99Ratio, buf);
   else
     std::printf("soak: p99 first / last window after warm-up: %s (not checked: --max-p99-ratio)\n", buf);

@@ -43,9 +43,7 @@ static bool contextLost(cudaError_t error) {
     case cudaErrorHardwareStackError:
     case cudaErrorAssert:
     case cudaErrorLaunchTimeout:
-    case cudaErrorECCUncorrectable:
-    case cudaErrorDevicesUnavailable:
-    case cudaErrorUnknown: return true;
+    case cudaErrorECCUncorrectable: return true;
     default: return false;
   }
 }

@@ -1,11 +1,12 @@
 #include "pvr/loop/loop_keys.h"
 
-#include <fcntl.h>
+#include <poll.h>
 #include <termios.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 
 namespace pvr {
 
@@ -26,41 +27,61 @@ std::string applyLoopKey(char key, RenderOptions& options) {
   return std::string("every material at ") + effectLevelName(g.effects);
 }
 
-struct TerminalKeys::Saved {
-  bool terminal = false;
-  termios mode{};
-  int flags = 0;
-};
+namespace {
 
-bool TerminalKeys::standardInputIsTerminal() { return isatty(STDIN_FILENO) == 1; }
+// The terminal's mode before photonvr changed it, restored by the destructor and, should the
+// process end another way (exit, an uncaught error), at exit.
+termios gSavedMode{};
+bool gModeChanged = false;
 
-TerminalKeys::TerminalKeys() : saved_(std::make_unique<Saved>()) {
-  saved_->flags = fcntl(STDIN_FILENO, F_GETFL);
-  if (saved_->flags < 0) {
-    ended_ = true;  // no standard input at all
-    return;
-  }
-  if (standardInputIsTerminal() && tcgetattr(STDIN_FILENO, &saved_->mode) == 0) {
-    termios raw = saved_->mode;
-    raw.c_lflag &= tcflag_t(~(ICANON | ECHO));  // keys as typed, not lines; not echoed over the log
-    raw.c_cc[VMIN] = 0;
-    raw.c_cc[VTIME] = 0;
-    saved_->terminal = tcsetattr(STDIN_FILENO, TCSANOW, &raw) == 0;
-  }
-  fcntl(STDIN_FILENO, F_SETFL, saved_->flags | O_NONBLOCK);
+void restoreTerminal() {
+  if (gModeChanged) tcsetattr(STDIN_FILENO, TCSANOW, &gSavedMode);
+  gModeChanged = false;
 }
 
-TerminalKeys::~TerminalKeys() {
-  if (saved_->flags >= 0) fcntl(STDIN_FILENO, F_SETFL, saved_->flags);
-  if (saved_->terminal) tcsetattr(STDIN_FILENO, TCSANOW, &saved_->mode);
+}  // namespace
+
+bool TerminalKeys::standardInputIsTerminal() {
+  // Only a process in the terminal's foreground group reads it: one in the background (under
+  // `timeout`, `cmd &`) would be stopped by SIGTTIN / SIGTTOU.
+  return isatty(STDIN_FILENO) == 1 && tcgetpgrp(STDIN_FILENO) == getpgrp();
 }
+
+TerminalKeys::TerminalKeys() {
+  if (isatty(STDIN_FILENO) == 1) {
+    if (!standardInputIsTerminal() || tcgetattr(STDIN_FILENO, &gSavedMode) != 0) {
+      ended_ = true;
+      return;
+    }
+    termios keys = gSavedMode;
+    keys.c_lflag &= tcflag_t(~(ICANON | ECHO));  // keys as typed, not lines; not echoed over the log
+    keys.c_cc[VMIN] = 1;                         // read only after poll saw a key: one byte, no wait
+    keys.c_cc[VTIME] = 0;
+    if (tcsetattr(STDIN_FILENO, TCSANOW, &keys) == 0) {
+      gModeChanged = true;
+      static const bool registered = std::atexit(restoreTerminal) == 0;
+      (void)registered;
+    }
+  }
+}
+
+TerminalKeys::~TerminalKeys() { restoreTerminal(); }
 
 int TerminalKeys::next() {
   if (ended_) return -1;
+  // poll, not O_NONBLOCK: the flag would belong to the open file, which a terminal shares with
+  // standard output and error (their writes could then fail).
+  pollfd in{STDIN_FILENO, POLLIN, 0};
+  const int ready = poll(&in, 1, 0);
+  if (ready == 0 || (ready < 0 && errno == EINTR)) return -1;
+  if (ready < 0 || !(in.revents & (POLLIN | POLLHUP))) {
+    ended_ = true;
+    return -1;
+  }
   unsigned char c = 0;
   const ssize_t n = read(STDIN_FILENO, &c, 1);
   if (n == 1) return c;
-  if (n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) ended_ = true;
+  if (n == 0 || errno != EINTR) ended_ = true;  // end of a pipe or file
   return -1;
 }
 

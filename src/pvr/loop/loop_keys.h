@@ -5,7 +5,6 @@
 //   e          every material at the next level (from the scene's own levels: raster; path wraps
 //              to raster)
 //   0          each material at its own level again (the scene's)
-#include <memory>
 #include <string>
 
 #include "pvr/loop/presenter.h"
@@ -16,9 +15,10 @@ namespace pvr {
 // does nothing (the options are then unchanged).
 std::string applyLoopKey(char key, RenderOptions& options);
 
-// Standard input as a source of keys, read without blocking. A terminal is switched to
-// unbuffered, unechoed input while this lives (and restored after it); other input (a pipe, a
-// file) is read as it is. EOF or an error ends the keys.
+// Standard input as a source of keys, polled without blocking. A terminal is switched to
+// unbuffered, unechoed input while this lives (restored by the destructor, or at exit); other
+// input (a pipe, a file) is read as it is. EOF or an error ends the keys; so does a terminal of
+// which this process is not in the foreground.
 class TerminalKeys {
  public:
   TerminalKeys();
@@ -27,11 +27,10 @@ class TerminalKeys {
   TerminalKeys& operator=(const TerminalKeys&) = delete;
   // The next key typed or piped, or -1 if none is waiting.
   int next();
+  // Standard input is a terminal whose foreground process group is this process's.
   static bool standardInputIsTerminal();
 
  private:
-  struct Saved;
-  std::unique_ptr<Saved> saved_;
   bool ended_ = false;
 };
 

@@ -35,9 +35,10 @@ FaultPlan parseFaultPlan(const std::string& text) {
   bool known = false;
   for (Fault f : kFaults)
     if (kind == faultName(f)) plan.kind = f, known = true;
-  char* end = nullptr;
-  const unsigned long long n = count.empty() ? 0 : std::strtoull(count.c_str(), &end, 10);
-  if (!known || count.empty() || *end != '\0' || n == 0 || count[0] == '-')
+  const bool digits = !count.empty() && count.size() <= 12 &&
+                      count.find_first_not_of("0123456789") == std::string::npos;
+  const unsigned long long n = digits ? std::strtoull(count.c_str(), nullptr, 10) : 0;
+  if (!known || n == 0)
     throw Error("PVR_INJECT_FAULT must be KIND:N with KIND gpu-alloc, gpu-fault, vk-alloc or vk-device-lost and N >= 1, got '" +
                 text + "'");
   plan.active = true;
@@ -60,5 +61,14 @@ bool faultInjected(Fault kind) {
 }
 
 uint64_t faultEvents(Fault kind) { return gEvents[size_t(kind)].load(std::memory_order_relaxed); }
+
+std::string faultPlanReport() {
+  const FaultPlan& plan = faultPlan();
+  if (!plan.active) return "";
+  const uint64_t n = faultEvents(plan.kind);
+  return std::string("fault plan ") + faultName(plan.kind) + ":" + std::to_string(plan.event) + ": " + std::to_string(n) +
+         " " + faultName(plan.kind) + " events, the planned one " +
+         (n >= plan.event ? "happened and the run went on" : "did not happen");
+}
 
 }  // namespace pvr

@@ -2,8 +2,9 @@
 // Faults provoked on purpose, so that the reliability tests can show what photonvr does when the
 // GPU runs out of memory at any allocation site or the device is lost: PVR_INJECT_FAULT=KIND:N
 // makes the Nth event of KIND fail as the driver would report it (docs/reliability.md).
-//   gpu-alloc       a CUDA device allocation (cudaMalloc answers cudaErrorMemoryAllocation)
-//   gpu-fault       a CUDA frame (a kernel traps before the frame's work: the context is lost,
+//   gpu-alloc       a CUDA device allocation (cudaMalloc answers cudaErrorMemoryAllocation; the
+//                   one pinned host buffer of the photon tracer is not counted)
+//   gpu-fault       a CUDA eye pass (a kernel traps before the pass's work: the context is lost,
 //                   cudaErrorLaunchFailure, as after a kernel fault or an Xid)
 //   vk-alloc        a Vulkan memory allocation (VK_ERROR_OUT_OF_DEVICE_MEMORY)
 //   vk-device-lost  a Vulkan queue submission (VK_ERROR_DEVICE_LOST)
@@ -35,5 +36,10 @@ bool faultInjected(Fault kind);
 uint64_t faultEvents(Fault kind);
 
 const char* faultName(Fault kind);
+
+// For a run that ended well under a plan: how many events of the plan's kind it counted and
+// whether the planned one happened (then it was survived, or swallowed), e.g. "fault plan
+// gpu-alloc:40: 39 gpu-alloc events, the planned one did not happen". Empty without a plan.
+std::string faultPlanReport();
 
 }  // namespace pvr
