@@ -27,7 +27,8 @@
 #endif
 #endif
 #ifdef PVR_ASAN
-#include <sanitizer/allocator_interface.h>
+// The sanitizer runtime's count of live allocations (gcc ships no header for it; libasan has it).
+extern "C" size_t __sanitizer_get_current_allocated_bytes();
 #endif
 
 namespace pvr {
