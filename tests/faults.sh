@@ -19,36 +19,14 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 small=(--backend cpu --eye-size 32x36 --photons 32x32)
 printf '0 0.5 2.6 0 0 0 1 0.5 0.5\n0.02 0.5 2.6 0 0.02 0 1 0.5 0.5\n0.04 0.5 2.6 0 0.04 0 1 0.5 0.5\n' >"$out/three.traj"
 
-# sweep NAME KIND EXPECTED-SUBSTRING COMMAND...: the command with the KIND's 1st, 2nd, ... event
-# failing; stops at the first N the command survives (that N - 1 events were each provoked).
+fault_sweep_dir=$out
+source "$(dirname "$0")/fault_sweep.sh"
 sweep() {
-  local name=$1 kind=$2 expected=$3
-  shift 3
-  local n rc lines
-  for ((n = 1; n <= 200; ++n)); do
-    PVR_INJECT_FAULT=$kind:$n timeout 60 "$@" >"$out/stdout" 2>"$out/stderr"
-    rc=$?
-    # stderr lines other than the failure (the soak's or xr's notes) do not count, warnings do.
-    lines=$(grep -c . "$out/stderr")
-    if [ $rc -eq 0 ]; then
-      # The run outlived the plan: it must say that the planned event did not happen (else the
-      # fault was swallowed) and count the events the sweep made fail.
-      if ! grep -q "fault plan $kind:$n: $((n - 1)) $kind events, the planned one did not happen" "$out/stderr"; then
-        fail "$name: $kind:$n: the run went on: $(cat "$out/stderr")"
-        return
-      fi
-      if [ $n -eq 1 ]; then fail "$name: no $kind event happened"; return; fi
-      echo "ok   $name: $((n - 1)) $kind event(s), each failing cleanly; e.g. $(cat "$out/first")"
-      return
-    fi
-    if [ $rc -ge 124 ]; then fail "$name: $kind:$n: exit code $rc (a hang or a crash)"; return; fi
-    if [ $rc -ne 1 ] || [ "$lines" -ne 1 ] || ! grep -q -- "$expected" "$out/stderr"; then
-      fail "$name: $kind:$n: exit code $rc, expected one line with '$expected', got: $(cat "$out/stderr")"
-      return
-    fi
-    [ $n -eq 1 ] && cp "$out/stderr" "$out/first"
-  done
-  fail "$name: more than 200 $kind events"
+  local result
+  result=$(fault_sweep "$@")
+  echo "$result"
+  grep -q '^FAIL' <<<"$result" && failures=$((failures + 1))
+  return 0
 }
 
 raster=("$exe" render cornell "${small[@]}" --primary raster --trajectory "$out/three.traj" --out "$out/r")

@@ -26,7 +26,6 @@ if ! "$exe" render --backend cuda --eye-size 8x8 --photons 8x8 --out "$out/probe
   echo "FAIL: the CUDA probe render failed: $(cat "$out/probe.err")"
   exit 1
 fi
-fail() { echo "FAIL: $*"; }
 small=(--backend cuda --eye-size 96x104 --photons 64x64)
 # A textured quad in the Cornell box (its texture: a PNG photonvr renders), so that textures are
 # uploaded without test models installed.
@@ -37,43 +36,10 @@ printf '{"base": "cornell", "meshes": [{"file": "quad.obj", "scale": 0.2, "trans
 printf '0 0.5 2.6 0 0 0 1 0.4 0.5\n0.02 0.5 2.6 0 0.02 0 1 0.5 0.5\n0.04 0.5 2.6 0 0.04 0 1 0.6 0.5\n' >"$out/three.traj"
 traj=(--trajectory "$out/three.traj")
 
-# Each sweep runs in the background in its own folder (the GPU and 16 cores take them at once) and
-# prints its result in one write as soon as it ends, so a run cut short still shows what ended.
-sweep() {  # name kind expected-substring command...
-  local name=$1 kind=$2 expected=$3
-  shift 3
-  local n rc start
-  local out
-  out=$(mktemp -d -p "$top")
-  : >"$out/sites"
-  : >"$out/secs"
-  for ((n = 1; n <= 400; ++n)); do
-    start=$SECONDS
-    PVR_INJECT_FAULT=$kind:$n timeout 60 "$@" >"$out/stdout" 2>"$out/stderr"
-    rc=$?
-    if [ $rc -eq 0 ]; then
-      # The run outlived the plan: it must say that the planned event did not happen (else the
-      # fault was swallowed) and count the events the sweep made fail.
-      if ! grep -q "fault plan $kind:$n: $((n - 1)) $kind events, the planned one did not happen" "$out/stderr"; then
-        fail "$name: $kind:$n: the run went on: $(cat "$out/stderr")"
-        return
-      fi
-      if [ $n -eq 1 ]; then fail "$name: no $kind event happened"; return; fi
-      printf '%s\n%s\n' "ok   $name: $((n - 1)) $kind event(s), each one line and exit 1 (slowest $(sort -n "$out/secs" | tail -1) s)" \
-        "$(sort "$out/sites" | uniq -c | sed 's/^ */       /')"
-      return
-    fi
-    echo $((SECONDS - start)) >>"$out/secs"
-    if [ $rc -ge 124 ]; then fail "$name: $kind:$n: exit code $rc (a hang or a crash): $(cat "$out/stderr")"; return; fi
-    if [ $rc -ne 1 ] || [ "$(grep -c . "$out/stderr")" -ne 1 ] || ! grep -q -- "$expected" "$out/stderr"; then
-      fail "$name: $kind:$n: exit code $rc, expected one line with '$expected', got: $(cat "$out/stderr")"
-      return
-    fi
-    # The allocation's label: "GPU out of memory: LABEL needs ..."
-    sed -n 's/.*GPU out of memory: \(.*\) needs .*/\1/p' "$out/stderr" >>"$out/sites"
-  done
-  fail "$name: more than 400 $kind events"
-}
+# Each sweep runs in the background (the GPU and 16 cores take them at once) and prints its
+# result as soon as it ends, so a run cut short still shows what ended.
+fault_sweep_dir=$top
+source "$(dirname "$0")/fault_sweep.sh"
 
 runs=(
   "scatter+TAA|render cornell-caustics ${small[*]} --stereo scatter --kernel shared --taa ${traj[*]} --out $out/a"
@@ -89,12 +55,12 @@ for entry in "${runs[@]}"; do
   # The two sweeps of a run at once: each writes its own images and statistics.
   read -r -a alloc <<<"${entry#*|}"
   read -r -a fault <<<"$(sed -e "s|--out $out/|--out $out/fault-|" -e "s|--stats $out/|--stats $out/fault-|" <<<"${entry#*|}")"
-  sweep "$name" gpu-alloc "GPU out of memory" "$exe" "${alloc[@]}" 2>&1 | tee -a "$top/results" &
-  sweep "$name" gpu-fault "the GPU device was lost" "$exe" "${fault[@]}" 2>&1 | tee -a "$top/results" &
+  fault_sweep "$name" gpu-alloc "GPU out of memory" "$exe" "${alloc[@]}" 2>&1 | tee -a "$top/results" &
+  fault_sweep "$name" gpu-fault "the GPU device was lost" "$exe" "${fault[@]}" 2>&1 | tee -a "$top/results" &
 done
 read -r -a args <<<"render cornell-caustics ${small[*]} --primary raster --stereo gather ${traj[*]} --out $out/h"
-sweep "pre-pass shared with CUDA" vk-device-lost "VK_ERROR_DEVICE_LOST" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
-sweep "pre-pass shared with CUDA" vk-alloc "Vulkan: out of memory" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
+fault_sweep "pre-pass shared with CUDA" vk-device-lost "VK_ERROR_DEVICE_LOST" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
+fault_sweep "pre-pass shared with CUDA" vk-alloc "Vulkan: out of memory" "$exe" "${args[@]}" 2>&1 | tee -a "$top/results" &
 wait
 failures=$(grep -c '^FAIL' "$top/results")
 [ "$failures" -eq 0 ] && echo "all GPU fault cases passed" || echo "$failures GPU fault case(s) failed"
