@@ -2,7 +2,9 @@
 # Fuzzes photonvr's input parsers with libFuzzer (clang, ASan + UBSan, leaks checked): the JSON
 # scene format, mesh import (glTF/GLB/OBJ through assimp), foveation masks, trajectories and the
 # command line (parsed and checked, nothing run).
-#   usage: scripts/fuzz.sh [SECONDS_PER_HARNESS (default 30)] [BUILD_DIR (default build-fuzz)]
+#   usage: scripts/fuzz.sh [SECONDS_PER_HARNESS (default 30)] [BUILD_DIR (default build-fuzz)] [HARNESS,...]
+#   PVR_FUZZ_SANITIZERS (default address,undefined; e.g. undefined,leak for long runs, about 15x the
+#   executions of ASan's on the command line) and PVR_FUZZ_FORK (workers, default 1) for long runs.
 # Seeds: the project's test data and scenes, and Debian's assimp-testmodels (its glTF2 samples,
 # broken glTF2 files and invalid/ models). Prints one line per harness (executions, findings);
 # a finding's input lands in BUILD_DIR/artifacts/HARNESS/ and the script exits non-zero.
@@ -12,10 +14,13 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh clang libclang-rt-14-dev
 seconds=${1:-30}
 build=${2:-build-fuzz}
-flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+sanitizers=${PVR_FUZZ_SANITIZERS:-address,undefined}
+fork=${PVR_FUZZ_FORK:-1}
+flags="-fsanitize=fuzzer-no-link,$sanitizers -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPVR_ENABLE_CUDA=OFF -DPVR_FUZZ=ON \
-  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=$sanitizers" >/dev/null
 harnesses=(scene_json mesh mask trajectory cli)
+[ -n "${3:-}" ] && IFS=, read -r -a harnesses <<<"$3"
 cmake --build "$build" -j"$(nproc)" --target "${harnesses[@]/#/pvr_fuzz_}" >/dev/null
 
 models=/usr/share/assimp/models
@@ -40,9 +45,14 @@ for h in "${harnesses[@]}"; do
   [ -d "tests/fuzz/regressions/$h" ] && seed "$h" tests/fuzz/regressions/"$h"/*
   log=$build/fuzz_$h.log
   rc=0
-  "$build/tests/pvr_fuzz_$h" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2560 -print_final_stats=1 \
+  extra=()
+  [ "$fork" -gt 1 ] && extra=(-fork="$fork")
+  "$build/tests/pvr_fuzz_$h" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2560 -print_final_stats=1 "${extra[@]}" \
     -artifact_prefix="$build/artifacts/$h/" "$build/corpus/$h" >"$log" 2>&1 || rc=$?
-  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+  # One process prints its total; under -fork the parent's last "#N" line counts all workers.
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || true)
+  [ -n "$runs" ] || runs=$(grep -o '^#[0-9]*' "$log" | tr -d '#' | sort -n | tail -1 || true)
+  runs=${runs:-0}
   found=$(find "$build/artifacts/$h" -type f | wc -l)
   echo "fuzz $h: $runs executions in ${seconds} s, corpus $(find "$build/corpus/$h" -type f | wc -l) inputs," \
     "$found finding(s), exit $rc"
