@@ -3,8 +3,8 @@
 # scene format, mesh import (glTF/GLB/OBJ through assimp), foveation masks, trajectories and the
 # command line (parsed and checked, nothing run).
 #   usage: scripts/fuzz.sh [SECONDS_PER_HARNESS (default 30)] [BUILD_DIR (default build-fuzz)] [HARNESS,...]
-#   PVR_FUZZ_SANITIZERS (default address,undefined; e.g. undefined,leak for long runs, about 15x the
-#   executions of ASan's on the command line) and PVR_FUZZ_FORK (workers, default 1) for long runs.
+#   PVR_FUZZ_SANITIZERS (default address,undefined) and PVR_FUZZ_FORK (libFuzzer workers, default
+#   1) for long runs on many cores, e.g. PVR_FUZZ_FORK=16 scripts/fuzz.sh 3600 build-fuzz mesh,cli.
 # Seeds: the project's test data and scenes, and Debian's assimp-testmodels (its glTF2 samples,
 # broken glTF2 files and invalid/ models). Prints one line per harness (executions, findings);
 # a finding's input lands in BUILD_DIR/artifacts/HARNESS/ and the script exits non-zero.
