@@ -1,4 +1,5 @@
-# Sourced by tests/faults.sh and tests/gpu_faults.sh: the sweep of an injected fault over a run.
+# Sourced by tests/faults.sh and tests/gpu_faults.sh: the sweep of an injected fault over a run,
+# and the inputs both tests make.
 #   fault_sweep NAME KIND EXPECTED COMMAND...
 # runs COMMAND with PVR_INJECT_FAULT=KIND:1, KIND:2, ... Each run must end with one line on stderr
 # containing EXPECTED, exit code 1, within 60 s (no hang). The sweep ends at the first N the run
@@ -42,4 +43,17 @@ fault_sweep() {
     sed -n 's/.*GPU out of memory: \(.*\) needs .*/\1/p' "$dir/stderr" >>"$dir/sites"
   done
   echo "FAIL: $name: more than 400 $kind events"
+}
+
+# The fault tests' inputs. A textured quad in the Cornell box: DIR/NAME.json, a mesh whose map_Kd
+# is TEXTURE (a file name in DIR).
+write_textured_quad() {  # DIR NAME TEXTURE
+  printf 'newmtl m\nKd 0.8 0.8 0.8\nmap_Kd %s\n' "$3" >"$1/$2.mtl"
+  printf 'mtllib %s.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 4/4 3/3 2/2\n' \
+    "$2" >"$1/$2.obj"
+  printf '{"base": "cornell", "meshes": [{"file": "%s.obj", "scale": 0.2, "translate": [0, 0.2, 0]}]}\n' "$2" >"$1/$2.json"
+}
+# Three frames of a small step and turn with a moving gaze: FILE.
+write_three_frames() {  # FILE
+  printf '0 0.5 2.6 0 0 0 1 0.4 0.5\n0.02 0.5 2.6 0 0.02 0 1 0.5 0.5\n0.04 0.5 2.6 0 0.04 0 1 0.6 0.5\n' >"$1"
 }

@@ -17,10 +17,10 @@ trap 'rm -rf "$out"' EXIT
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 small=(--backend cpu --eye-size 32x36 --photons 32x32)
-printf '0 0.5 2.6 0 0 0 1 0.5 0.5\n0.02 0.5 2.6 0 0.02 0 1 0.5 0.5\n0.04 0.5 2.6 0 0.04 0 1 0.5 0.5\n' >"$out/three.traj"
 
 fault_sweep_dir=$out
 source "$(dirname "$0")/fault_sweep.sh"
+write_three_frames "$out/three.traj"
 sweep() {
   local result
   result=$(fault_sweep "$@")
@@ -48,9 +48,7 @@ fi
 # A corrupt texture: the render goes on, the material keeps its constant colour, one warning.
 "$exe" render cornell --backend cpu --eye-size 16x16 --photons 8x8 --out "$out/tex" >/dev/null 2>&1
 head -c 300 "$out/tex_left.png" >"$out/corrupt.png"
-printf 'newmtl m\nKd 0.8 0.8 0.8\nmap_Kd corrupt.png\n' >"$out/quad.mtl"
-printf 'mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 4/4 3/3 2/2\n' >"$out/quad.obj"
-printf '{"base": "cornell", "meshes": [{"file": "quad.obj", "scale": 0.2, "translate": [0, 0.2, 0]}]}\n' >"$out/corrupt.json"
+write_textured_quad "$out" corrupt corrupt.png
 "$exe" render "$out/corrupt.json" "${small[@]}" --out "$out/c" >/dev/null 2>"$out/stderr"
 rc=$?
 if [ $rc -ne 0 ] || [ "$(grep -c . "$out/stderr")" -ne 1 ] ||

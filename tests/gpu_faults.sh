@@ -26,20 +26,18 @@ if ! "$exe" render --backend cuda --eye-size 8x8 --photons 8x8 --out "$out/probe
   echo "FAIL: the CUDA probe render failed: $(cat "$out/probe.err")"
   exit 1
 fi
+fault_sweep_dir=$top
+source "$(dirname "$0")/fault_sweep.sh"
 small=(--backend cuda --eye-size 96x104 --photons 64x64)
 # A textured quad in the Cornell box (its texture: a PNG photonvr renders), so that textures are
 # uploaded without test models installed.
 "$exe" render cornell --backend cpu --eye-size 16x16 --photons 8x8 --out "$out/tex" >/dev/null 2>&1
-printf 'newmtl m\nKd 0.8 0.8 0.8\nmap_Kd tex_left.png\n' >"$out/quad.mtl"
-printf 'mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl m\nf 1/1 4/4 3/3 2/2\n' >"$out/quad.obj"
-printf '{"base": "cornell", "meshes": [{"file": "quad.obj", "scale": 0.2, "translate": [0, 0.2, 0]}]}\n' >"$out/textured.json"
-printf '0 0.5 2.6 0 0 0 1 0.4 0.5\n0.02 0.5 2.6 0 0.02 0 1 0.5 0.5\n0.04 0.5 2.6 0 0.04 0 1 0.6 0.5\n' >"$out/three.traj"
+write_textured_quad "$out" textured tex_left.png
+write_three_frames "$out/three.traj"
 traj=(--trajectory "$out/three.traj")
 
 # Each sweep runs in the background (the GPU and 16 cores take them at once) and prints its
 # result as soon as it ends, so a run cut short still shows what ended.
-fault_sweep_dir=$top
-source "$(dirname "$0")/fault_sweep.sh"
 
 runs=(
   "scatter+TAA|render cornell-caustics ${small[*]} --stereo scatter --kernel shared --taa ${traj[*]} --out $out/a"

@@ -30,7 +30,7 @@ std::string applyLoopKey(char key, RenderOptions& options) {
 namespace {
 
 // The terminal's mode before photonvr changed it, restored by the destructor and, should the
-// process end another way (exit, an uncaught error), at exit.
+// process exit without unwinding to it, by an atexit handler.
 termios gSavedMode{};
 bool gModeChanged = false;
 
