@@ -1,6 +1,7 @@
 // The CUDA backend against the CPU reference (label `gpu`; runs on a machine with a CUDA GPU,
 // and reports every test as skipped elsewhere). Same scene, seed and options on both backends:
 // the stored photons, the hash grid and the images must agree.
+#include <cuda_runtime.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include "gpu_ray_throughput.h"
 #include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/cuda/cuda_frame_backend.h"
+#include "pvr/cuda/image_checks.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/image/image_compare.h"
 #include "pvr/reference/progressive_reference.h"
@@ -687,6 +689,28 @@ TEST(GpuBackend, EffectGroupLevelsMatchTheCpu) {
     EXPECT_LT(c.outliers, 0.005) << what;
     EXPECT_GT(c.firstPrimAgree, 0.995) << what;
   }
+}
+
+// The soak's check of every frame on the GPU: pixels with a NaN or an infinity in any component,
+// each pixel once, at the image's first and last pixel too; a clean frame counts none.
+TEST(GpuBackend, NonFinitePixelsAreCountedOnTheDevice) {
+  PVR_REQUIRE_GPU();
+  const Scene scene = builtinScene("cornell");
+  Renderer renderer(scene, BackendKind::Cuda);
+  renderer.rig().width = 97, renderer.rig().height = 61;  // not a multiple of a block
+  renderer.options().photonsX = renderer.options().photonsY = 64;
+  renderer.renderFrame(renderer.rig().head, nullptr, FrameOutput::DeviceBuffers);
+  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Left), 0u);
+  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Right), 0u);
+  const size_t pixels = size_t(97) * 61;
+  const float nan = std::nanf(""), inf = INFINITY;
+  auto* image = const_cast<Vec3*>(renderer.deviceImage(Eye::Right));
+  const std::pair<size_t, Vec3> poisoned[] = {{0, Vec3{nan, 0, 0}}, {7, Vec3{0.5f, inf, nan}},
+                                              {4000, Vec3{0, 0, -inf}}, {pixels - 1, Vec3{nan, nan, nan}}};
+  for (const auto& [i, v] : poisoned) ASSERT_EQ(cudaMemcpy(image + i, &v, sizeof v, cudaMemcpyHostToDevice), cudaSuccess);
+  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Right), 4u);
+  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Left), 0u);
+  EXPECT_EQ(cuda::countNonFinitePixels(image, pixels - 1, renderer.deviceStream()), 3u);  // the last one left out
 }
 
 }  // namespace

@@ -1,6 +1,4 @@
 #include <cub/device/device_select.cuh>
-#include <thrust/execution_policy.h>
-#include <thrust/fill.h>
 #include <thrust/iterator/counting_iterator.h>
 
 #include "pvr/cuda/density.cuh"
@@ -10,6 +8,14 @@ namespace pvr::cuda {
 namespace {
 
 // Foveated rendering: the mask's vertices in use for a gaze (any triangle overlapping the image).
+// Every pixel's sample spacing at 1 before the raster writes the covered ones (as on the CPU). A
+// kernel rather than thrust::fill_n, whose policy waits for the stream and reports a failure of
+// earlier work as its own.
+__global__ void fillSpacingKernel(float* spacing, size_t pixels) {
+  const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < pixels) spacing[i] = 1.0f;
+}
+
 __global__ void markUsedVerticesKernel(DeviceMaskView mask, int gazeX, int gazeY, int width, int height, uint8_t* used) {
   uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
   if (t >= mask.triangleCount) return;
@@ -133,7 +139,8 @@ void GpuEyePass::renderFoveated(const DeviceScene& scene, DeviceMap map, const E
   // A gaze inside the image leaves no pixel uncovered; these are for the rest.
   PVR_CUDA_CHECK(cudaMemsetAsync(images_[e].data(), 0, pixels * sizeof(Vec3), stream));
   PVR_CUDA_CHECK(cudaMemsetAsync(inverseDepth_[e].data(), 0, pixels * sizeof(float), stream));
-  thrust::fill_n(thrust::cuda::par.on(stream), sampleSpacing_[e].data(), pixels, 1.0f);  // as on the CPU
+  launch("sample spacing fill", fillSpacingKernel, blocksFor(pixels, 256), 256, 0, stream, sampleSpacing_[e].data(),
+         size_t(pixels));
   const VertexValues values{vertexColours_.data(), vertexInverseDepths_.data()};
   const RasterTarget target{images_[e].data(), inverseDepth_[e].data(), sampleSpacing_[e].data(), camera.width,
                             camera.height};

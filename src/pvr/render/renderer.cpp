@@ -4,6 +4,7 @@
 #include "pvr/util/error.h"
 #ifdef PVR_HAVE_CUDA
 #include "pvr/cuda/cuda_frame_backend.h"
+#include "pvr/cuda/image_checks.h"
 #endif
 
 namespace pvr {
@@ -47,6 +48,17 @@ Renderer::Renderer(const Scene& scene, BackendKind backend)
 size_t gpuMemoryUsedBytes() {
 #ifdef PVR_HAVE_CUDA
   return cudaDeviceMemoryUsedBytes();
+#else
+  return 0;
+#endif
+}
+
+uint64_t countNonFiniteDevicePixels(const Renderer& renderer, Eye eye) {
+  const Vec3* image = renderer.deviceImage(eye);
+  if (!image) return 0;
+#ifdef PVR_HAVE_CUDA
+  return cuda::countNonFinitePixels(image, size_t(renderer.rig().width) * size_t(renderer.rig().height),
+                                    renderer.deviceStream());
 #else
   return 0;
 #endif

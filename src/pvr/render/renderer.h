@@ -66,4 +66,9 @@ class Renderer {
   FrameRenderer frames_;
 };
 
+// The pixels with a non-finite component (NaN, +-Inf) in an eye's image that the last frame left in
+// GPU memory (FrameOutput::DeviceBuffers), counted on the GPU: a check of every frame without a
+// readback. 0 where no such image exists (the CPU backend).
+uint64_t countNonFiniteDevicePixels(const Renderer& renderer, Eye eye);
+
 }  // namespace pvr
