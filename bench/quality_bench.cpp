@@ -43,6 +43,7 @@ struct Variant {
   bool denoise, taa;
   int photonBatches;  ///< a rolling photon map's slices (1: every photon every frame)
   bool freshNoise = true;  ///< new random numbers every frame (the default under TAA or the denoiser)
+  PixelSampling sampling = PixelSampling::BlueNoise;
 };
 constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"TAA", false, true, 1},
@@ -51,7 +52,12 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"denoise, rolling 8", true, false, 8},
                                  {"denoise + TAA, rolling 8", true, true, 8},
                                  {"denoise, rolling 16", true, false, 16},
-                                 {"denoise, same noise", true, false, 1, false}};
+                                 {"denoise, same noise", true, false, 1, false},
+                                 // The sampling before blue noise, for comparison.
+                                 {"raw, white noise", false, false, 1, true, PixelSampling::White},
+                                 {"TAA, white noise", false, true, 1, true, PixelSampling::White},
+                                 {"denoise, white noise", true, false, 1, true, PixelSampling::White},
+                                 {"denoise + TAA, white noise", true, true, 1, true, PixelSampling::White}};
 
 // Flicker of shown frames a -> b where the reference does not change: the mean absolute change of
 // luminance over the pixels whose references differ by less than 2 % (and 0.002 absolute), over
@@ -190,6 +196,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       vo.denoise.enabled = v.denoise;
       vo.temporal.enabled = v.taa;
       vo.photonBatches = v.photonBatches;
+      vo.gather.sampling = v.sampling;
       renderer->setFreshNoisePerFrame(v.freshNoise);
       std::vector<double> denoiseMs, frameMs, relMse, ssim, flickers, referenceFlickers, unexplained;
       std::vector<std::array<Image, 2>> shown(sampled.size());
@@ -215,7 +222,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
           flickers.push_back(f.shown), referenceFlickers.push_back(f.reference), unexplained.push_back(f.unexplained);
         }
       const double m = mean(relMse), fl = mean(flickers), un = mean(unexplained);
-      if (!v.denoise && !v.taa) rawRelMse = m, rawFlicker = fl, rawUnexplained = un;
+      if (&v == &kVariants[0]) rawRelMse = m, rawFlicker = fl, rawUnexplained = un;  // "raw"
       const LatencyStats dn = latencyStats(denoiseMs), fr = latencyStats(frameMs);
       // Every variant must stay near the reference (a broken path shows here), and the denoiser
       // must bring the image closer than the raw frame.
@@ -243,7 +250,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"flicker_of_raw", rawFlicker > 0 ? fl / rawFlicker : 1.0},
                       {"reference_flicker", mean(referenceFlickers)}, {"unexplained_flicker", un},
                       {"unexplained_flicker_of_raw", rawUnexplained > 0 ? un / rawUnexplained : 1.0},
-                      {"fresh_noise", v.freshNoise}, {"denoise_ms", dn},
+                      {"fresh_noise", v.freshNoise},
+                      {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"}, {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});
     }
@@ -263,6 +271,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       RenderOptions vo = o;
       vo.denoise.enabled = v.denoise;
       vo.temporal.enabled = v.taa;
+      vo.gather.sampling = v.sampling;
       ReferenceError at[3];
       Image last, stillShown;
       std::vector<double> changes;  // after the still frames, moving: frame-to-frame change of the left eye
@@ -304,6 +313,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
         if (!v.denoise) writePng(centreCrop(still[0], kCrop), args.qualityImages + "_" + scene.name + "_still_reference.png");
       }
       json.push_back({{"suite", "quality"}, {"scene", scene.name}, {"head", "still"}, {"variant", v.name},
+                      {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"},
                       {"backend", renderer->name()}, {"device", renderer->deviceName()},
                       {"eye_size", {start.width, start.height}}, {"photons", 512 * 512},
                       {"radius", o.gather.density.radius}, {"frames", kStillFrames},

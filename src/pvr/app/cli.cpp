@@ -87,6 +87,7 @@ struct RenderArgs {
   std::string ipd;      // empty: the scene's rig (63 mm)
   int spp = 1;
   uint32_t seed = 1;
+  std::string sampling = "blue-noise";
   int photonDepth = 8;
   int specularDepth = 8;
   int shadowRays = 1;  // to the punctual lights per gather point; 0: one per light
@@ -221,6 +222,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
                  "right image) | gather (ours: right hits looked up in the left image); reuse is for diffuse surfaces only")
       ->capture_default_str();
   cmd.add_option("--seed", a.seed, "Seed of the counter-based random numbers")->capture_default_str();
+  cmd.add_option("--sampling", a.sampling,
+                 "A pixel's first random numbers (sub-pixel position, light sample): blue-noise (dithered by a "
+                 "void-and-cluster mask, low-discrepancy from frame to frame) | white (independent)")
+      ->capture_default_str();
   cmd.add_option("--photon-depth", a.photonDepth, "Maximum surface interactions per photon path")->capture_default_str();
   cmd.add_option("--shadow-rays", a.shadowRays,
                  "Shadow rays to the point and spot lights per shaded point, each to one light chosen by its "
@@ -307,6 +312,9 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   }
   o.gather.samplesPerPixel = a.spp;
   o.gather.seed = a.seed;
+  if (a.sampling == "blue-noise") o.gather.sampling = PixelSampling::BlueNoise;
+  else if (a.sampling == "white") o.gather.sampling = PixelSampling::White;
+  else throw Error("--sampling must be blue-noise or white, got '" + a.sampling + "'");
   o.maxPhotonDepth = a.photonDepth;
   o.gather.maxSpecularDepth = a.specularDepth;
   o.gather.punctualShadowRays = a.shadowRays;
@@ -421,10 +429,11 @@ int runRender(const RenderArgs& a) {
   std::printf("scene %s: %u triangles, %u emitting, %zu point/spot/sun lights, %u textures; eyes %dx%d, IPD %.1f mm\n",
               scene.name.c_str(), scene.triangleCount(), scene.lightTriangleCount(), scene.punctualLights().size(),
               scene.textureCount(), rig.width, rig.height, rig.ipd * 1000.0f);
-  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, %d shadow rays per point (0: one per light), seed %u\n", options.photonsX,
+  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, %d shadow rays per point (0: one per light), %s sampling, seed %u\n", options.photonsX,
               options.photonsY, options.gather.density.radius, a.map.c_str(), a.estimator.c_str(),
               options.gather.density.estimator == Estimator::Knn ? (" (k=" + std::to_string(a.k) + ")").c_str() : "",
-              options.gather.samplesPerPixel, options.gather.punctualShadowRays, options.gather.seed);
+              options.gather.samplesPerPixel, options.gather.punctualShadowRays,
+              options.gather.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white", options.gather.seed);
   std::printf("backend %s: %s%s\n", renderer->name().c_str(), renderer->deviceName().c_str(),
               renderer->name() == "cuda" ? (", " + std::string(densityKernelName(options.kernel)) + " kernel").c_str() : "");
   const char* names[2] = {"left", "right"};

@@ -19,6 +19,12 @@ namespace pvr {
 
 enum class ShadingMode : int { Full = 0, PhotonMapOnly = 1 };
 
+// How a pixel draws its first random numbers (its sub-pixel position and first light sample).
+enum class PixelSampling : uint8_t {
+  White = 0,      ///< independent hashed numbers (the reference's passes)
+  BlueNoise = 1,  ///< blue-noise dithered, low-discrepancy over a run of frames (util/blue_noise.h)
+};
+
 struct GatherParams {
   DensityParams density;
   ShadingMode mode = ShadingMode::Full;
@@ -30,6 +36,11 @@ struct GatherParams {
   int punctualShadowRays = 1;
   bool jitterFirstSample = false;  ///< false: sample 0 through the pixel centre (a stable first hit)
   uint32_t seed = 1;
+  PixelSampling sampling = PixelSampling::BlueNoise;
+  // The frame's number in a run of frames that blend (TAA, the denoiser, a still head's
+  // refinement): each pixel's samples go on along their sequences, and the photons and hashed
+  // numbers are new every frame. 0: a frame on its own.
+  uint32_t sequenceIndex = 0;
   // Sample 0's first hits rasterised (the G-buffer pre-pass), set by the backend for one eye pass;
   // none: traced. Ignored when the first sample is jittered.
   PrimaryHitsView primary;
@@ -452,9 +463,24 @@ PVR_HOST_DEVICE Vec3 radianceAlongRay(const SceneView& scene, const Intersector&
   return finishGather(map, traceToGatherPoint(scene, intersector, params, ray, rng), params.density);
 }
 
-// The random numbers of sample s of one pixel of one eye.
-PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, Eye eye, uint32_t pixelIndex, int s) {
-  return CounterRng(hashCombine(params.seed, 0x51ed270bu + uint32_t(eye)), pixelIndex, uint32_t(s));
+// The random numbers of sample s of stream `stream` (a pixel's index, or an image position's
+// hash) of one eye: hashed.
+PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, Eye eye, uint32_t stream, int s) {
+  uint32_t key = hashCombine(params.seed, 0x51ed270bu + uint32_t(eye));
+  if (params.sequenceIndex) key = hashCombine(key, params.sequenceIndex);
+  return CounterRng(key, stream, uint32_t(s));
+}
+
+// The random numbers of sample s of pixel (x, y) of one eye: the first ones blue noise, unless
+// params.sampling says White. Sample s of frame k is number k * samplesPerPixel + s of the pixel's
+// sequences; each eye scrambles its own.
+PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
+                                           int s) {
+  CounterRng rng = pixelRng(params, eye, uint32_t(y) * uint32_t(camera.width) + uint32_t(x), s);
+  if (params.sampling == PixelSampling::BlueNoise)
+    rng.useBlueNoise(uint32_t(x), uint32_t(y), params.sequenceIndex * uint32_t(params.samplesPerPixel) + uint32_t(s),
+                     hashCombine(params.seed, 0xb10e5u + uint32_t(eye)));
+  return rng;
 }
 
 // The camera ray of sample s of pixel (x, y), with the random numbers that continue its path. The
@@ -462,7 +488,7 @@ PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, Eye eye, 
 // params.jitterFirstSample (a reference's box filter).
 PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
                                           int s, CounterRng& rng) {
-  rng = pixelRng(params, eye, uint32_t(y) * uint32_t(camera.width) + uint32_t(x), s);
+  rng = pixelRng(params, camera, eye, x, y, s);
   const bool centre = s == 0 && !params.jitterFirstSample;
   // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
   float jx = centre ? 0.5f : rng.uniform();
@@ -485,9 +511,8 @@ PVR_HOST_DEVICE GatherPoint imagePositionGatherPoint(const SceneView& scene, con
                                                      float px, float py, float& inverseDepth) {
   int ix = int(floorf(px)), iy = int(floorf(py));
   bool inside = ix >= 0 && iy >= 0 && ix < camera.width && iy < camera.height;
-  uint32_t stream = inside ? uint32_t(iy) * uint32_t(camera.width) + uint32_t(ix)
-                           : hashCombine(hashCombine(0x9e3779b9u, uint32_t(ix)), uint32_t(iy)) | 0x80000000u;
-  CounterRng rng = pixelRng(params, eye, stream, 0);
+  CounterRng rng = inside ? pixelRng(params, camera, eye, ix, iy, 0)
+                          : pixelRng(params, eye, hashCombine(hashCombine(0x9e3779b9u, uint32_t(ix)), uint32_t(iy)) | 0x80000000u, 0);
   Ray ray = camera.generateRay(px, py);
   Hit first;
   intersector.intersect(ray, INFINITY, first);

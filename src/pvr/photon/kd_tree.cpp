@@ -1,9 +1,9 @@
 #include "pvr/photon/kd_tree.h"
 
-#include <tbb/task_group.h>
-
 #include <algorithm>
 #include <bit>
+
+#include "pvr/util/parallel_for.h"
 
 namespace pvr {
 
@@ -38,10 +38,7 @@ struct Builder {
     axes[node] = uint8_t(axis);
     nodeToInput[node] = order[median];
     if (n > 16384) {
-      tbb::task_group tasks;
-      tasks.run([&] { build(2 * node + 1, begin, median); });
-      build(2 * node + 2, median + 1, end);
-      tasks.wait();
+      parallelInvoke([&] { build(2 * node + 1, begin, median); }, [&] { build(2 * node + 2, median + 1, end); });
     } else {
       build(2 * node + 1, begin, median);
       build(2 * node + 2, median + 1, end);

@@ -66,7 +66,7 @@ struct RenderOptions {
   PhotonTraceParams photonTraceParams() const {
     PhotonTraceParams p;
     p.photonCount = photonCount();
-    p.seed = gather.seed;
+    p.seed = gather.sequenceIndex ? hashCombine(gather.seed, 0x7e3a9u + gather.sequenceIndex) : gather.seed;  // new each frame of a run
     p.maxDepth = maxPhotonDepth;
     p.storeDirect = gather.mode == ShadingMode::PhotonMapOnly;  // the map alone then shades
     return p;

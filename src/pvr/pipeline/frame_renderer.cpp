@@ -127,7 +127,7 @@ bool samePicture(const RenderOptions& a, const RenderOptions& b) {
               ga.density.radius == gb.density.radius && ga.density.estimator == gb.density.estimator &&
               ga.density.k == gb.density.k && ga.mode == gb.mode && ga.maxSpecularDepth == gb.maxSpecularDepth &&
               ga.samplesPerPixel == gb.samplesPerPixel && ga.punctualShadowRays == gb.punctualShadowRays &&
-              ga.seed == gb.seed && a.eyes[0] == b.eyes[0] && a.eyes[1] == b.eyes[1] && a.stereo == b.stereo &&
+              ga.seed == gb.seed && ga.sampling == gb.sampling && a.eyes[0] == b.eyes[0] && a.eyes[1] == b.eyes[1] && a.stereo == b.stereo &&
               a.foveation.mask == b.foveation.mask && a.temporal.enabled == b.temporal.enabled;
   for (int e = 0; e < 2 && same && a.foveation.mask; ++e)
     same = a.foveation.gaze[e][0] == b.foveation.gaze[e][0] && a.foveation.gaze[e][1] == b.foveation.gaze[e][1];
@@ -185,7 +185,7 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
   validateOptions(requested, rig);
   RenderOptions options = requested;
   if (requested.temporal.enabled || requested.denoise.enabled) {
-    if (freshNoise_) options.gather.seed = hashCombine(requested.gather.seed, 0x7e3a9u + blendedFrames_);
+    if (freshNoise_) options.gather.sequenceIndex = blendedFrames_;
     ++blendedFrames_;
   }
   // A still head refines: each still frame's photons are gathered with a smaller radius.

@@ -39,6 +39,7 @@ void ProgressiveReference::addPass() {
   RenderOptions pass = options_;
   pass.gather.density.radius = radiusOfPass(passes_);
   pass.gather.seed = hashCombine(options_.gather.seed, uint32_t(passes_));
+  pass.gather.sampling = PixelSampling::White;  // independent passes: the error estimate assumes it
   FrameResult frame = renderer_.render(rig_, pass);
   frameMs_ += frame.timings.totalMs();
   for (int e = 0; e < 2; ++e) {

@@ -14,4 +14,7 @@ void parallelFor(const char* label, size_t n, size_t grain, const std::function<
 void parallelForTiles(const char* label, int rows, int cols, int tile,
                       const std::function<void(int y0, int y1, int x0, int x1)>& body);
 
+// a() and b() at the same time (a recursive build's two halves); returns when both have.
+void parallelInvoke(const std::function<void()>& a, const std::function<void()>& b);
+
 }  // namespace pvr
