@@ -163,8 +163,9 @@ struct DirectLightFrames {
   FrameRenderer renderer = makeCpuFrameRenderer(scene);
   StereoRig rig = scene.rig;
   DirectLightFrames() { rig.width = rig.height = 64; }
-  Image frame(PixelSampling sampling, uint32_t seed, uint32_t sequenceIndex) {
+  Image frame(PixelSampling sampling, uint32_t seed, uint32_t sequenceIndex, int samplesPerPixel = 1) {
     RenderOptions o;
+    o.gather.samplesPerPixel = samplesPerPixel;
     o.photonsX = o.photonsY = 16;
     o.eyes[1] = false;
     o.gather.overrideEffects = true;
@@ -230,6 +231,26 @@ TEST(BlueNoise, RenderedErrorIsUnbiasedAndFallsUnderFilteringAndAccumulation) {
   EXPECT_LT(accumulated[0], 0.6 * accumulated[1]) << accumulated[0] << " vs " << accumulated[1];
   std::printf("relMSE blue / white: raw %.4g / %.4g, 4x4 box %.4g / %.4g, 16 frames %.4g / %.4g\n", raw[0], raw[1],
               filtered[0], filtered[1], accumulated[0], accumulated[1]);
+}
+
+// Two samples per pixel (the centre, and a jittered one) over a run of 64 frames of one seed: each
+// pixel's mean converges to its own expectation, as with independent numbers (each sample runs
+// through the whole sequence with its own scramble, so no sample is held in part of [0, 1)).
+TEST(BlueNoise, SeveralSamplesPerPixelConvergeOverFrames) {
+  DirectLightFrames frames;
+  frames.rig.width = frames.rig.height = 32;
+  std::vector<Image> white;
+  for (uint32_t s = 0; s < 256; ++s) white.push_back(frames.frame(PixelSampling::White, 5000 + s, 0, 2));
+  const Image reference = DirectLightFrames::mean(white);
+  std::vector<Image> blueRun, whiteRun;
+  for (uint32_t k = 0; k < 64; ++k) {
+    blueRun.push_back(frames.frame(PixelSampling::BlueNoise, 3, k, 2));
+    whiteRun.push_back(frames.frame(PixelSampling::White, 3, k, 2));
+  }
+  const double blue = compareToReference(DirectLightFrames::mean(blueRun), reference).relMse;
+  const double independent = compareToReference(DirectLightFrames::mean(whiteRun), reference).relMse;
+  EXPECT_LT(blue, independent) << blue << " vs " << independent;
+  std::printf("2 spp, 64 frames: relMSE %.4g (blue noise) vs %.4g (independent)\n", blue, independent);
 }
 
 }  // namespace

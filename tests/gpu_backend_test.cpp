@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "gpu_ray_throughput.h"
+#include "gpu_sampling.h"
 #include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/cuda/cuda_frame_backend.h"
 #include "pvr/cuda/image_checks.h"
@@ -700,17 +701,43 @@ TEST(GpuBackend, NonFinitePixelsAreCountedOnTheDevice) {
   renderer.rig().width = 97, renderer.rig().height = 61;  // not a multiple of a block
   renderer.options().photonsX = renderer.options().photonsY = 64;
   renderer.renderFrame(renderer.rig().head, nullptr, FrameOutput::DeviceBuffers);
-  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Left), 0u);
-  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Right), 0u);
+  DeviceImageCheck check;
+  uint64_t counts[2] = {9, 9};
+  check.nonFinitePixels(renderer, counts);
+  EXPECT_EQ(counts[0], 0u);
+  EXPECT_EQ(counts[1], 0u);
   const size_t pixels = size_t(97) * 61;
   const float nan = std::nanf(""), inf = INFINITY;
   auto* image = const_cast<Vec3*>(renderer.deviceImage(Eye::Right));
   const std::pair<size_t, Vec3> poisoned[] = {{0, Vec3{nan, 0, 0}}, {7, Vec3{0.5f, inf, nan}},
                                               {4000, Vec3{0, 0, -inf}}, {pixels - 1, Vec3{nan, nan, nan}}};
   for (const auto& [i, v] : poisoned) ASSERT_EQ(cudaMemcpy(image + i, &v, sizeof v, cudaMemcpyHostToDevice), cudaSuccess);
-  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Right), 4u);
-  EXPECT_EQ(countNonFiniteDevicePixels(renderer, Eye::Left), 0u);
-  EXPECT_EQ(cuda::countNonFinitePixels(image, pixels - 1, renderer.deviceStream()), 3u);  // the last one left out
+  check.nonFinitePixels(renderer, counts);  // the counters are reused
+  EXPECT_EQ(counts[0], 0u);
+  EXPECT_EQ(counts[1], 4u);
+  cuda::NonFiniteCounter counter;
+  const Vec3* rightOnly[2] = {nullptr, image};
+  counter.count(rightOnly, pixels - 1, renderer.deviceStream(), counts);  // the last pixel left out
+  EXPECT_EQ(counts[0], 0u);
+  EXPECT_EQ(counts[1], 3u);
+}
+
+// Blue-noise sampling (util/blue_noise.h) draws the same 32-bit numbers on the GPU as on the host:
+// the mask's device copy, the radical inverses (__brev and 64-bit division there), the hashed
+// dimensions after them; over pixels across the mask's tiles and sequence numbers up to 2^32 - 1.
+TEST(GpuBackend, BlueNoiseSamplesAreTheHostsToTheBit) {
+  PVR_REQUIRE_GPU();
+  std::vector<SamplerInput> inputs;
+  for (uint32_t i = 0; i < 20000; ++i) {
+    const uint32_t h = hashCombine(99, i);
+    const uint32_t index = i < 5000 ? i : i < 10000 ? 0xffffffffu - (i - 5000) : h;
+    inputs.push_back({h % 8192u, (h >> 13) % 8192u, index, hashCombine(h, 1)});
+  }
+  const std::vector<uint32_t> gpu = drawSamplesOnGpu(inputs), host = drawSamplesOnHost(inputs);
+  ASSERT_EQ(gpu.size(), host.size());
+  size_t differing = 0;
+  for (size_t k = 0; k < gpu.size(); ++k) differing += gpu[k] != host[k];
+  EXPECT_EQ(differing, 0u) << "of " << gpu.size() << " words";
 }
 
 }  // namespace

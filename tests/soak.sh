@@ -20,7 +20,7 @@ cat "$out/log"
 [ $rc -eq 0 ] || fail "exit code $rc"
 tr -d ' \n' <"$out/soak.json" >"$out/flat"
 grep -q '"passed":true' "$out/flat" || fail "the soak's checks did not pass"
-grep -q '"non_finite_values":0' "$out/flat" || fail "non-finite pixels"
+grep -q '"non_finite_pixels":0' "$out/flat" || fail "non-finite pixels"
 grep -q '"reloads_failed":1' "$out/flat" || fail "not one failed reload"
 grep -q "soak: reload of '$out/broken.json' at frame 200 failed: .*; the previous scene keeps rendering" "$out/log" ||
   fail "the failed reload is not reported"

@@ -138,7 +138,9 @@ class SoakPresenter : public Presenter {
     if (!f.result) return;
     uint64_t nonFinite = 0;
     if (f.onDevice) {
-      for (Eye eye : {Eye::Left, Eye::Right}) nonFinite += countNonFiniteDevicePixels(f.renderer, eye);
+      uint64_t counts[2];
+      deviceCheck_.nonFinitePixels(f.renderer, counts);
+      nonFinite = counts[0] + counts[1];
     } else {
       for (const EyeResult& eye : f.result->eyes)
         for (const Vec3& p : eye.image.pixels) nonFinite += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
@@ -177,6 +179,7 @@ class SoakPresenter : public Presenter {
   RenderOptions base_;
   uint64_t changeEvery_;
   uint64_t frame_ = 0, nonFinite_ = 0, firstNonFiniteFrame_ = 0, deviceChecked_ = 0;
+  DeviceImageCheck deviceCheck_;
   size_t deviceBytes_ = 0;
   bool stopped_ = false;
   std::vector<std::vector<char>> leaked_;
@@ -445,7 +448,7 @@ int runSoakCommand(const SoakArgs& args, const LoopSetup& setup) {
   nlohmann::json names = nlohmann::json::array();
   for (const SoakState& s : states) names.push_back(s.name);
   out["states"] = names;
-  out["non_finite_values"] = presenter.nonFinite();
+  out["non_finite_pixels"] = presenter.nonFinite();
   out["frames_checked_on_gpu"] = presenter.deviceChecked();
   if (presenter.nonFinite()) out["first_non_finite_frame"] = presenter.firstNonFiniteFrame();
   nlohmann::json js = nlohmann::json::array();

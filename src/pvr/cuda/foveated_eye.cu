@@ -139,8 +139,9 @@ void GpuEyePass::renderFoveated(const DeviceScene& scene, DeviceMap map, const E
   // A gaze inside the image leaves no pixel uncovered; these are for the rest.
   PVR_CUDA_CHECK(cudaMemsetAsync(images_[e].data(), 0, pixels * sizeof(Vec3), stream));
   PVR_CUDA_CHECK(cudaMemsetAsync(inverseDepth_[e].data(), 0, pixels * sizeof(float), stream));
-  launch("sample spacing fill", fillSpacingKernel, blocksFor(pixels, 256), 256, 0, stream, sampleSpacing_[e].data(),
-         size_t(pixels));
+  if (pixels)
+    launch("sample spacing fill", fillSpacingKernel, blocksFor(pixels, 256), 256, 0, stream, sampleSpacing_[e].data(),
+           size_t(pixels));
   const VertexValues values{vertexColours_.data(), vertexInverseDepths_.data()};
   const RasterTarget target{images_[e].data(), inverseDepth_[e].data(), sampleSpacing_[e].data(), camera.width,
                             camera.height};

@@ -26,18 +26,24 @@ __global__ void countNonFiniteKernel(const Vec3* image, size_t pixels, unsigned 
 
 }  // namespace
 
-uint64_t countNonFinitePixels(const Vec3* image, size_t pixels, void* stream) {
-  if (!pixels) return 0;
+NonFiniteCounter::~NonFiniteCounter() {
+  if (counters_) deviceFree(counters_, 2 * sizeof(unsigned long long));
+}
+
+void NonFiniteCounter::count(const Vec3* const images[2], size_t pixels, void* stream, uint64_t counts[2]) {
+  counts[0] = counts[1] = 0;
+  if (!pixels || (!images[0] && !images[1])) return;
   auto s = static_cast<cudaStream_t>(stream);
-  DeviceBuffer<unsigned long long> total;
-  total.reserve(1, "non-finite pixel count");
-  PVR_CUDA_CHECK(cudaMemsetAsync(total.data(), 0, sizeof(unsigned long long), s));
+  if (!counters_) counters_ = static_cast<unsigned long long*>(deviceAllocate(2 * sizeof(unsigned long long), "non-finite pixel counts"));
+  PVR_CUDA_CHECK(cudaMemsetAsync(counters_, 0, 2 * sizeof(unsigned long long), s));
   // A few blocks per SM are enough for a memory-bound scan.
   const unsigned blocks = std::min(blocksFor(pixels, kThreads), 4096u);
-  launch("non-finite pixel count", countNonFiniteKernel, blocks, kThreads, 0, s, image, pixels, total.data());
-  unsigned long long count = 0;
-  total.download(&count, 1, s);
-  return count;
+  for (int e = 0; e < 2; ++e)
+    if (images[e]) launch("non-finite pixel count", countNonFiniteKernel, blocks, kThreads, 0, s, images[e], pixels, counters_ + e);
+  unsigned long long host[2] = {0, 0};
+  PVR_CUDA_CHECK(cudaMemcpyAsync(host, counters_, sizeof host, cudaMemcpyDeviceToHost, s));
+  PVR_CUDA_CHECK(cudaStreamSynchronize(s));
+  counts[0] = host[0], counts[1] = host[1];
 }
 
 }  // namespace pvr::cuda

@@ -8,8 +8,20 @@
 
 namespace pvr::cuda {
 
-// The number of pixels with a non-finite component (NaN, +-Inf) among `pixels` linear RGB values at
-// `image` (GPU memory), counted on `stream` (cudaStream_t) after the work queued on it; waits for it.
-uint64_t countNonFinitePixels(const Vec3* image, size_t pixels, void* stream);
+// Counts the pixels with a non-finite component (NaN, +-Inf) of linear RGB images in GPU memory.
+// Holds its two counters (allocated at the first count) from frame to frame.
+class NonFiniteCounter {
+ public:
+  NonFiniteCounter() = default;
+  ~NonFiniteCounter();
+  NonFiniteCounter(const NonFiniteCounter&) = delete;
+  NonFiniteCounter& operator=(const NonFiniteCounter&) = delete;
+  // Both eyes' images of `pixels` values each (a null one is skipped), counted on `stream`
+  // (cudaStream_t) after the work queued on it; waits for it once. Returns the two counts.
+  void count(const Vec3* const images[2], size_t pixels, void* stream, uint64_t counts[2]);
+
+ private:
+  unsigned long long* counters_ = nullptr;  // GPU memory, two counters
+};
 
 }  // namespace pvr::cuda

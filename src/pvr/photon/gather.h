@@ -472,14 +472,16 @@ PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, Eye eye, 
 }
 
 // The random numbers of sample s of pixel (x, y) of one eye: the first ones blue noise, unless
-// params.sampling says White. Sample s of frame k is number k * samplesPerPixel + s of the pixel's
-// sequences; each eye scrambles its own.
+// params.sampling says White. Frame k of a run is number k of the pixel's sequences for every
+// sample; each sample and eye scrambles its own. (Numbering the samples k * spp + s instead
+// would give sample s every spp-th Halton point: for a base dividing spp, a fixed part of
+// [0, 1), and the centre sample uses its dimensions for the light, the others for jitter.)
 PVR_HOST_DEVICE inline CounterRng pixelRng(const GatherParams& params, const EyeCamera& camera, Eye eye, int x, int y,
                                            int s) {
   CounterRng rng = pixelRng(params, eye, uint32_t(y) * uint32_t(camera.width) + uint32_t(x), s);
   if (params.sampling == PixelSampling::BlueNoise)
-    rng.useBlueNoise(uint32_t(x), uint32_t(y), params.sequenceIndex * uint32_t(params.samplesPerPixel) + uint32_t(s),
-                     hashCombine(params.seed, 0xb10e5u + uint32_t(eye)));
+    rng.useBlueNoise(uint32_t(x), uint32_t(y), params.sequenceIndex,
+                     hashCombine(hashCombine(params.seed, 0xb10e5u + uint32_t(eye)), uint32_t(s)));
   return rng;
 }
 

@@ -53,14 +53,23 @@ size_t gpuMemoryUsedBytes() {
 #endif
 }
 
-uint64_t countNonFiniteDevicePixels(const Renderer& renderer, Eye eye) {
-  const Vec3* image = renderer.deviceImage(eye);
-  if (!image) return 0;
+struct DeviceImageCheck::Impl {
 #ifdef PVR_HAVE_CUDA
-  return cuda::countNonFinitePixels(image, size_t(renderer.rig().width) * size_t(renderer.rig().height),
-                                    renderer.deviceStream());
+  cuda::NonFiniteCounter counter;
+#endif
+};
+
+DeviceImageCheck::DeviceImageCheck() : impl_(std::make_unique<Impl>()) {}
+DeviceImageCheck::~DeviceImageCheck() = default;
+
+void DeviceImageCheck::nonFinitePixels(const Renderer& renderer, uint64_t counts[2]) {
+  counts[0] = counts[1] = 0;
+#ifdef PVR_HAVE_CUDA
+  const Vec3* images[2] = {renderer.deviceImage(Eye::Left), renderer.deviceImage(Eye::Right)};
+  if (!images[0] && !images[1]) return;
+  impl_->counter.count(images, size_t(renderer.rig().width) * size_t(renderer.rig().height), renderer.deviceStream(), counts);
 #else
-  return 0;
+  (void)renderer;
 #endif
 }
 

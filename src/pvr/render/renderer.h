@@ -66,9 +66,21 @@ class Renderer {
   FrameRenderer frames_;
 };
 
-// The pixels with a non-finite component (NaN, +-Inf) in an eye's image that the last frame left in
-// GPU memory (FrameOutput::DeviceBuffers), counted on the GPU: a check of every frame without a
-// readback. 0 where no such image exists (the CPU backend).
-uint64_t countNonFiniteDevicePixels(const Renderer& renderer, Eye eye);
+// Counts the pixels with a non-finite component (NaN, +-Inf) in the eyes' images that the last
+// frame left in GPU memory (FrameOutput::DeviceBuffers), on the GPU: a check of every frame
+// without a readback. Keeps its GPU counters from frame to frame.
+class DeviceImageCheck {
+ public:
+  DeviceImageCheck();
+  ~DeviceImageCheck();
+  DeviceImageCheck(const DeviceImageCheck&) = delete;
+  DeviceImageCheck& operator=(const DeviceImageCheck&) = delete;
+  // Per eye; 0 for an eye with no image in GPU memory (the CPU backend, an eye not rendered).
+  void nonFinitePixels(const Renderer& renderer, uint64_t counts[2]);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace pvr

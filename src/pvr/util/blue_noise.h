@@ -7,8 +7,8 @@
 // void-and-cluster mask (neighbouring pixels get far-apart values, so one frame's error is
 // high-frequency noise that any spatial filter, the eye included, removes more of). Each dimension
 // reads the mask at its own toroidal shift and adds its own random rotation, both from
-// `scramble`, so a value is exactly uniform over scrambles: unbiased, like the white stream it
-// replaces.
+// `scramble`, so over scrambles a value is uniform (as uniform as the hash): unbiased, like the
+// white stream it replaces.
 #include "pvr/pvr.h"
 
 namespace pvr {
