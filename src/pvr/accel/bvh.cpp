@@ -9,6 +9,7 @@
 
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "pvr/util/parallel_for.h"
 
 namespace pvr {
 namespace {
@@ -214,7 +215,8 @@ Bvh Bvh::build(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& i
   if (count == 0) {
     Flattener(input, bvh.nodes_, bvh.triangles_, bvh.stats_).flattenRoot(nullptr, rootBounds);
   } else {
-    RTCDevice device = rtcNewDevice(nullptr);
+    const int threads = libraryThreadLimit();
+    RTCDevice device = rtcNewDevice(threads ? ("threads=" + std::to_string(threads)).c_str() : nullptr);
     if (!device) throw Error("Embree: cannot create a device for the BVH build");
     RTCBVH handle = rtcNewBVH(device);
     RTCBuildArguments args = rtcDefaultBuildArguments();

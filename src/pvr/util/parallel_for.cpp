@@ -96,6 +96,14 @@ void parallelForTiles(const char* label, int rows, int cols, int tile,
   }
 }
 
+int libraryThreadLimit() {
+#ifdef PVR_PARALLEL_STD_THREADS
+  return 1;
+#else
+  return 0;
+#endif
+}
+
 void parallelInvoke(const std::function<void()>& a, const std::function<void()>& b) {
 #ifdef PVR_PARALLEL_STD_THREADS
   runChunks(2, [&](size_t c) { c == 0 ? a() : b(); });

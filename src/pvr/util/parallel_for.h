@@ -17,4 +17,9 @@ void parallelForTiles(const char* label, int rows, int cols, int tile,
 // a() and b() at the same time (a recursive build's two halves); returns when both have.
 void parallelInvoke(const std::function<void()>& a, const std::function<void()>& b);
 
+// The threads a library with a pool of its own (Embree's BVH builder, which calls photonvr's
+// callbacks on its TBB workers) should use: 0 for its default; 1 in the ThreadSanitizer build,
+// which cannot see that pool's synchronisation.
+int libraryThreadLimit();
+
 }  // namespace pvr
