@@ -1,5 +1,6 @@
 // The microfacet BSDF (shading/bsdf.h): white furnace (energy <= 1, sampling agrees with the
-// BSDF integrated by quadrature, the single-scattering loss stated), reciprocity, the chi-square
+// BSDF integrated by quadrature, a white metal keeps 1 with Kulla-Conty's lobe, the uncompensated
+// losses stated), the GGX albedo table against quadrature, reciprocity, the chi-square
 // test of sampled directions against the pdf, and the BSDF-weighted density estimate against
 // exact direct light on a glossy floor.
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include "pvr/cpu/cpu_backend.h"
 #include "pvr/photon/gather.h"
 #include "pvr/shading/bsdf.h"
+#include "pvr/shading/ggx_albedo_generator.h"
 
 namespace pvr {
 namespace {
@@ -42,9 +44,10 @@ Vec3 directionAt(const BsdfParams& b, float cosTheta, float phi) {
   return normalize(Frame::fromNormal(b.normal).toWorld({s * std::cos(phi), s * std::sin(phi), cosTheta}));
 }
 
-// The integral of f |cos| over one side of the surface in polar coordinates about `axis` (the
+// The integral of f(wi) |cos| over one side of the surface in polar coordinates about `axis` (the
 // lobe's peak), with angles from it spaced as s^2 so that cells are finest where a sharp lobe is.
-double sideIntegral(const BsdfParams& b, Vec3 wo, Vec3 axis, bool upper) {
+template <class F>
+double sideIntegral(Vec3 normal, Vec3 axis, bool upper, const F& f) {
   const int nS = 16000, nPhi = 48;  // the lobe is near-symmetric about its axis: phi matters little
   Frame frame = Frame::fromNormal(axis);
   double sum = 0;
@@ -54,12 +57,15 @@ double sideIntegral(const BsdfParams& b, Vec3 wo, Vec3 axis, bool upper) {
       double phi = 2.0 * kPi * (j + 0.5) / nPhi;
       Vec3 wi = normalize(frame.toWorld({float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
                                          float(std::cos(theta))}));
-      float cosI = dot(b.normal, wi);
+      float cosI = dot(normal, wi);
       if ((cosI > 0.0f) != upper) continue;
-      sum += double(luminance(b.eval(wo, wi))) * std::fabs(cosI) * std::sin(theta) * dTheta * (2.0 * kPi / nPhi);
+      sum += double(f(wi)) * std::fabs(cosI) * std::sin(theta) * dTheta * (2.0 * kPi / nPhi);
     }
   }
   return sum;
+}
+double sideIntegral(const BsdfParams& b, Vec3 wo, Vec3 axis, bool upper) {
+  return sideIntegral(b.normal, axis, upper, [&](Vec3 wi) { return luminance(b.eval(wo, wi)); });
 }
 
 // The albedo by quadrature, independent of the sampling code: the reflection side about the
@@ -100,12 +106,14 @@ TEST_P(BsdfFurnace, SamplingAgreesWithQuadratureAndConservesEnergy) {
     EXPECT_LE(mean, 1.0 + 4 * sigma + 1e-5) << c.name << " cos_o " << cosO;
     EXPECT_LE(quad, 1.005) << c.name << " cos_o " << cosO;
     EXPECT_NEAR(mean, quad, 4 * sigma + 0.01 * quad) << c.name << " cos_o " << cosO;
-    // Single scattering: no compensation of the energy that multiple bounces between microfacets
-    // would return. Stated bounds: at most 10% lost at roughness <= 0.3, 70% by a white metal at
-    // roughness 1 (1 - ln 2 kept at normal incidence), and nothing by the Lambertian base.
-    // Inside glass, total internal reflection sends most light back into the reflection lobe, whose
-    // single-scattering loss is then largest: at roughness 1 down to 40%.
-    double floor = c.roughness <= 0.3f ? 0.9 : c.inside ? 0.4 : c.metallic == 1.0f ? 0.3 : 0.65;
+    // Kulla-Conty's lobe gives back what one microfacet bounce loses: a white metal reflects 1
+    // (within the table's interpolation) and nothing is lost by the Lambertian base. Not
+    // compensated, with the stated bounds: a white plastic's base under a rough layer (the layer's
+    // coupling assumes a smooth interface; at grazing angles, roughness 1 keeps 0.69), at most 10%
+    // at roughness <= 0.3; and transmission: inside glass, total internal reflection sends most
+    // light back into the reflection lobe, not compensated from that side: at roughness 1 down to 40%.
+    if (c.transmission == 0.0f && c.metallic == 1.0f) EXPECT_NEAR(quad, 1.0, 0.005) << c.name << " cos_o " << cosO;
+    double floor = c.roughness <= 0.3f ? 0.9 : c.inside ? 0.4 : 0.65;
     if (c.specularF0 == 0.0f && c.metallic == 0.0f && c.transmission == 0.0f) floor = 0.999;
     EXPECT_GE(quad, floor) << c.name << " cos_o " << cosO;
   }
@@ -127,12 +135,67 @@ INSTANTIATE_TEST_SUITE_P(
       return s;
     });
 
+// The albedo table of ggx_albedo.h is the generator's output.
+TEST(GgxAlbedo, TableIsTheGeneratorsOutput) {
+  const GgxAlbedoTable t = makeGgxAlbedoTable();
+  ASSERT_EQ(t.albedo.size(), size_t(kGgxAlbedoSize * kGgxAlbedoSize));
+  for (size_t k = 0; k < t.albedo.size(); ++k)
+    ASSERT_NEAR(t.albedo[k], kGgxAlbedoTable[k], 2e-6f) << "ggx_albedo_table.inc is not makeGgxAlbedoTable() at " << k;
+  for (int j = 0; j < kGgxAlbedoSize; ++j) ASSERT_NEAR(t.averageAlbedo[j], kGgxAverageAlbedoTable[j], 2e-6f) << j;
+}
+
+// The single-scattering albedo E(mu, alpha) = int D(h) G2 (o.h) / mu over the microfacet normals h
+// whose reflection leaves above the horizon, by quadrature in h (theta = atan(alpha tan t), fine
+// where a sharp lobe is): independent of the visible-normal sampling that made the table.
+double albedoOfOneBounce(float mu, float alpha) {
+  const Ggx ggx{alpha};
+  const double cosO = mu, sinO = std::sqrt(1.0 - double(mu) * mu);
+  const int nT = 2000, nPhi = 128;
+  const double tMax = std::atan(std::tan(0.5 * kPi - 1e-6) / alpha);
+  double sum = 0.0;
+  for (int i = 0; i < nT; ++i) {
+    const double t = (i + 0.5) * tMax / nT, x = std::tan(t);
+    const double dTheta = alpha / (1.0 + double(alpha) * alpha * x * x) * (tMax / nT) / (std::cos(t) * std::cos(t));
+    const double theta = std::atan(alpha * x), c = std::cos(theta), s = std::sin(theta);
+    for (int j = 0; j < nPhi; ++j) {
+      const double phi = 2.0 * kPi * (j + 0.5) / nPhi;
+      const double oh = sinO * s * std::cos(phi) + cosO * c, iz = 2.0 * oh * c - cosO;
+      if (!(oh > 0.0) || !(iz > 0.0)) continue;
+      sum += double(ggx.D(float(c), float(s * s))) * ggx.G2(mu, float(iz)) * oh / cosO * s * dTheta * (2.0 * kPi / nPhi);
+    }
+  }
+  return sum;
+}
+
 // GGX at alpha 1 has D = 1 / pi and Lambda(mu) = (1 / mu - 1) / 2, so a white metal seen head-on
-// reflects exactly the integral of mu / (1 + mu) over 0..1: 1 - ln 2.
-TEST(Bsdf, WhiteRoughMetalHeadOnKeepsOneMinusLnTwo) {
+// reflects exactly the integral of mu / (1 + mu) over 0..1 in one bounce: 1 - ln 2. The table has
+// it, agrees with quadrature at its nodes (2e-4) and between them (bilinear: within 1% for
+// mu >= 0.1), and its E_avg (of the interpolated rows) is the exact cosine-weighted mean within 0.2%.
+TEST(GgxAlbedo, TableAgreesWithQuadratureAndOneMinusLnTwo) {
+  EXPECT_NEAR(albedoOfOneBounce(1.0f, 1.0f), 1.0 - std::log(2.0), 2e-4);
+  EXPECT_NEAR(ggxAlbedo(1.0f, 1.0f), 1.0 - std::log(2.0), 2e-4);
+  for (int j : {3, 10, 20, 31})
+    for (int i : {4, 12, 31}) {
+      const float mu = ggxAlbedoNodeMu(i), alpha = ggxAlbedoNodeAlpha(j);
+      EXPECT_NEAR(ggxAlbedo(mu, alpha), albedoOfOneBounce(mu, alpha), 2e-4) << "node mu " << mu << " alpha " << alpha;
+    }
+  for (float roughness : {0.17f, 0.45f, 0.83f})
+    for (float mu : {0.1f, 0.37f, 0.71f}) {
+      const float alpha = roughness * roughness;
+      const double exact = albedoOfOneBounce(mu, alpha);
+      EXPECT_NEAR(ggxAlbedo(mu, alpha), exact, 0.01 * exact) << "mu " << mu << " roughness " << roughness;
+    }
+  for (int j : {5, 15, 25, 31}) {
+    const float alpha = ggxAlbedoNodeAlpha(j);
+    EXPECT_NEAR(ggxAverageAlbedo(alpha), integrateGgxAverageAlbedo(alpha), 2e-3) << "alpha " << alpha;
+  }
+}
+
+// With Kulla-Conty's lobe a white metal seen head-on at alpha 1 reflects 1 (not 1 - ln 2), by
+// sampling too; a gold one reflects more than one bounce gives, and at most 1.
+TEST(Bsdf, RoughMetalsKeepTheirEnergy) {
   BsdfParams b = paramsOf(Config{"metal r1", 1, 1, 0, 0.04f, false});
-  double quad = albedoByQuadrature(b, b.normal);
-  EXPECT_NEAR(quad, 1.0 - std::log(2.0), 2e-4);
+  EXPECT_NEAR(albedoByQuadrature(b, b.normal), 1.0, 2e-3);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
   double sum = 0;
@@ -142,7 +205,22 @@ TEST(Bsdf, WhiteRoughMetalHeadOnKeepsOneMinusLnTwo) {
     BsdfSample s = sampleBsdf(b, b.normal, uLobe, u1, u2);
     if (s.valid()) sum += s.weight.x;
   }
-  EXPECT_NEAR(sum / n, 1.0 - std::log(2.0), 2e-3);
+  EXPECT_NEAR(sum / n, 1.0, 2e-3);
+  b.baseColor = {1.0f, 0.78f, 0.34f};  // gold-like F0
+  for (float cosO : {0.9f, 0.5f, 0.15f}) {
+    const Vec3 wo = directionAt(b, cosO, 0.3f);
+    const double one = sideIntegral(b.normal, reflect(-wo, b.normal), true, [&](Vec3 wi) {
+      const Vec3 h = normalize(wo + wi);
+      const Ggx ggx{b.alpha};
+      const float cosI = dot(b.normal, wi), cosOut = dot(b.normal, wo);
+      return luminance(b.reflectionFresnel(fmaxf(dot(wo, h), 0.0f))) * ggx.D(b.normal, h) * ggx.G2(cosOut, cosI) /
+             (4.0f * cosOut * cosI);
+    });
+    const double all = albedoByQuadrature(b, wo);
+    std::printf("gold r1 cos_o %.2f: one bounce %.4f, with Kulla-Conty %.4f\n", cosO, one, all);
+    EXPECT_GT(all, one + 0.05) << cosO;
+    EXPECT_LE(all, 1.0) << cosO;
+  }
 }
 
 // Extreme parameters (a layer reflecting everything, the sharpest lobe, grazing and total internal

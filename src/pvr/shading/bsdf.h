@@ -3,7 +3,7 @@
 // KHR_materials_transmission), written once for eye paths, photon paths, direct light and the
 // density estimate:
 //
-//   f = m F_metal(h.o) R + (1 - m) [ F_d(h.o) R + (1 - t) A(cos_o, cos_i) C / pi + t (1 - F_d(h.o)) C T ]
+//   f = m F_metal(h.o) R + (1 - m) [ F_d(h.o) R + (1 - t) A(cos_o, cos_i) C / pi + t (1 - F_d(h.o)) C T ] + f_ms
 //
 // with m metallic, t transmission, C the base colour, R = D G2 / (4 |cos_o| |cos_i|) the GGX
 // reflection lobe, T Walter et al.'s (2007) GGX transmission lobe, F_metal Schlick's with
@@ -12,9 +12,13 @@
 // angle), and A the diffuse base's coupling to the layer (diffuseScale). glTF's own
 // (1 - F(h.o)) weighting of the base is not used: it gains up to 30% energy at grazing angles,
 // and Ashikhmin-Shirley's coupling darkens rough plastics at grazing angles by half.
-// The microfacet lobes are single-scattering, without multiple-scattering compensation (a
-// documented choice, docs/scene-format.md): rough metals lose energy, GGX at alpha 1 keeping
-// exactly 1 - ln 2 = 0.307 at normal incidence (the furnace test checks this and states the rest).
+// The reflection lobe R includes Kulla and Conty's (2017) multiple-scattering lobe, which gives
+// back the energy that one microfacet bounce loses (a white GGX metal at alpha 1 keeps only
+// 1 - ln 2 = 0.307 of it head-on): f_ms = F_ms (1 - E(cos_o)) (1 - E(cos_i)) / (pi (1 - E_avg)),
+// E the lobe's tabulated albedo (ggx_albedo.h), F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg))
+// the light that leaves after further bounces with the cosine-averaged Fresnel F_avg. Reciprocal;
+// a white metal reflects 1 at every roughness and angle. Transmission's loss is not compensated
+// (rough glass loses energy; its table would need the ior as a third axis).
 //
 // Transmission is written in its importance-transport (photon) form, without the 1 / eta^2
 // radiance factor, for eye and photon paths alike: the smooth Glass material does the same, and
@@ -23,6 +27,7 @@
 // Lobes: diffuse, reflection and transmission, chosen for sampling in proportion to their
 // approximate albedo at wo and combined into one mixture pdf (one-sample MIS), so that a sample's
 // weight f |cos| / pdf is unbiased for any subset of lobes.
+#include "pvr/shading/ggx_albedo.h"
 #include "pvr/shading/microfacet.h"
 #include "pvr/util/sampling.h"
 
@@ -74,13 +79,55 @@ struct BsdfParams {
     return metal * metallic + Vec3(dielectricFresnel(cosO) * (1.0f - metallic));
   }
 
+  // Kulla-Conty's lobe (the header's f_ms) is colour * scale * (1 - E(cos_o)) (1 - E(cos_i)).
+  struct MultipleScattering {
+    Vec3 color{0, 0, 0};  ///< F_ms: the metal's and the dielectric layer's, mixed by metallic
+    float scale = 0.0f;   ///< 1 / (pi (1 - E_avg)); 0: none (a smooth lobe, or seen from inside)
+  };
+  PVR_HOST_DEVICE MultipleScattering multipleScattering() const {
+    MultipleScattering ms;
+    if (etaO > etaI) return ms;  // inside a dielectric: transmission's share is not compensated
+    const float averageAlbedo = ggxAverageAlbedo(alpha);
+    if (!(averageAlbedo < 1.0f - 1e-6f)) return ms;
+    ms.scale = kInvPi / (1.0f - averageAlbedo);
+    auto furtherBounces = [&](float averageFresnel) {
+      return averageFresnel * averageFresnel * averageAlbedo / (1.0f - averageFresnel * (1.0f - averageAlbedo));
+    };
+    // Schlick's Fresnel averaged over the cosine-weighted hemisphere: F0 + (F90 - F0) / 21.
+    const Vec3 metal = baseColor + (Vec3(1.0f) - baseColor) * (1.0f / 21.0f);
+    const float f90 = fminf(1.0f, 50.0f * specularF0);
+    const float dielectric = specularF0 + (f90 - specularF0) * (1.0f / 21.0f);
+    ms.color = Vec3(furtherBounces(metal.x), furtherBounces(metal.y), furtherBounces(metal.z)) * metallic +
+               Vec3(furtherBounces(dielectric) * (1.0f - metallic));
+    return ms;
+  }
+
+  // The reflection lobe's parts at wo (cosO > 0): single scattering (its approximate albedo, the
+  // Fresnel reflectance) and the multiple-scattering lobe (its exact albedo, colour (1 - E(cos_o))).
+  PVR_HOST_DEVICE void reflectionWeights(float cosO, float& single, float& multiple) const {
+    single = luminance(reflectionFresnel(cosO));
+    const MultipleScattering ms = multipleScattering();
+    multiple = ms.scale > 0.0f ? fmaxf(luminance(ms.color), 0.0f) * (1.0f - ggxAlbedo(cosO, alpha)) : 0.0f;
+  }
+  // The multiple-scattering lobe's share of reflection samples at wo.
+  PVR_HOST_DEVICE float multipleScatteringShare(float cosO) const {
+    float single, multiple;
+    reflectionWeights(cosO, single, multiple);
+    return multiple > 0.0f ? multiple / (single + multiple) : 0.0f;
+  }
+
   // Selection probabilities of the lobes in `lobes` at wo (local cosine cosO > 0); they sum to 1,
   // or are all 0 when none of them can reflect anything.
   PVR_HOST_DEVICE void lobeProbabilities(float cosO, uint32_t lobes, float p[3]) const {
     float fo = dielectricFresnel(cosO);
     float lum = fmaxf(luminance(baseColor), 0.0f);
     p[0] = (lobes & kLobeDiffuse) ? (1.0f - metallic) * (1.0f - transmission) * lum * (1.0f - fo) : 0.0f;
-    p[1] = (lobes & kLobeReflection) ? luminance(reflectionFresnel(cosO)) : 0.0f;
+    p[1] = 0.0f;
+    if (lobes & kLobeReflection) {
+      float single, multiple;
+      reflectionWeights(cosO, single, multiple);
+      p[1] = single + multiple;
+    }
     // Transmission keeps a share beyond the critical angle too: rough microfacets still refract.
     p[2] = (lobes & kLobeTransmission) ? (1.0f - metallic) * transmission * lum * fmaxf(1.0f - fo, 0.25f) : 0.0f;
     float sum = p[0] + p[1] + p[2];
@@ -110,6 +157,9 @@ struct BsdfParams {
         Vec3 h = normalize(wo + wi);
         float c = fmaxf(dot(wo, h), 0.0f);
         f += reflectionFresnel(c) * (ggx.D(normal, h) * ggx.G2(cosO, cosI) / (4.0f * cosO * cosI));
+        const MultipleScattering ms = multipleScattering();
+        if (ms.scale > 0.0f)
+          f += ms.color * (ms.scale * (1.0f - ggxAlbedo(cosO, alpha)) * (1.0f - ggxAlbedo(cosI, alpha)));
       }
     } else if (cosI < 0.0f && (lobes & kLobeTransmission) && transmission > 0.0f && metallic < 1.0f) {
       Vec3 h = transmissionHalfVector(wo, wi);
@@ -136,7 +186,9 @@ struct BsdfParams {
       float pdf = p[0] * cosI * kInvPi;
       if (p[1] > 0.0f) {
         Vec3 h = normalize(wo + wi);
-        pdf += p[1] * ggx.visibleNormalPdf(woL, frame.toLocal(h)) / (4.0f * fmaxf(dot(wo, h), 1e-8f));
+        const float share = multipleScatteringShare(cosO);  // sampled by the cosine
+        pdf += p[1] * ((1.0f - share) * ggx.visibleNormalPdf(woL, frame.toLocal(h)) / (4.0f * fmaxf(dot(wo, h), 1e-8f)) +
+                       share * cosI * kInvPi);
       }
       return pdf;
     }
@@ -170,9 +222,13 @@ PVR_HOST_DEVICE inline BsdfSample sampleBsdf(const BsdfParams& b, Vec3 wo, float
   if (uLobe < p[0]) {
     wiL = sampleCosineHemisphere(u1, u2);
   } else if (uLobe < p[0] + p[1]) {
-    Vec3 h = Ggx{b.alpha}.sampleVisibleNormal(woL, u1, u2);
-    wiL = h * (2.0f * dot(woL, h)) - woL;
-    if (!(wiL.z > 0.0f)) return out;
+    if (uLobe - p[0] < b.multipleScatteringShare(cosO) * p[1]) {  // the multiple-scattering lobe
+      wiL = sampleCosineHemisphere(u1, u2);
+    } else {
+      Vec3 h = Ggx{b.alpha}.sampleVisibleNormal(woL, u1, u2);
+      wiL = h * (2.0f * dot(woL, h)) - woL;
+      if (!(wiL.z > 0.0f)) return out;
+    }
   } else if (p[2] > 0.0f) {
     Vec3 h = Ggx{b.alpha}.sampleVisibleNormal(woL, u1, u2);
     float eta = b.etaO / b.etaI, cosH = dot(woL, h);
