@@ -512,6 +512,73 @@ TEST(SceneImport, GltfMetallicRoughnessAndEmissiveTexturesLoad) {
   EXPECT_TRUE(material("BaseNorm_Base").normalTexture.present());
 }
 
+// The Khronos cameras sample: a bare glTF file is viewed from its first perspective camera (at
+// (0.5, 0.5, 3), looking down -Z), not from the default framing; the import's scale, rotation and
+// translation move the camera with the mesh.
+TEST(SceneImport, GltfCameraIsTheViewpoint) {
+  const std::string path = "/usr/share/assimp/models/glTF2/cameras/Cameras.gltf";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "assimp-testmodels is not installed";
+  const Scene scene = loadScene(path);
+  auto near = [](Vec3 a, Vec3 b) { return length(a - b) < 1e-5f; };
+  EXPECT_TRUE(near(scene.rig.head.position, {0.5f, 0.5f, 3.0f}));
+  EXPECT_TRUE(near(scene.rig.head.toWorldDir({0, 0, -1}), {0, 0, -1}));
+  EXPECT_TRUE(near(scene.rig.head.toWorldDir({0, 1, 0}), {0, 1, 0}));
+  ImportOptions moved;
+  moved.scale = {2, 2, 2};
+  moved.rotation = Quat::fromAxisAngle({0, 1, 0}, 0.5f * kPi);  // -Z turns to -X
+  moved.translation = {1, 0, 0};
+  Scene other;
+  const std::optional<FileCamera> camera = importMeshFile(path, other, moved);
+  ASSERT_TRUE(camera.has_value());
+  EXPECT_TRUE(near(camera->pose.position, {1.0f + 6.0f, 1.0f, -1.0f})) << camera->pose.position.x;
+  EXPECT_TRUE(near(camera->pose.toWorldDir({0, 0, -1}), {-1, 0, 0}));
+  // A JSON scene takes it with "use_camera"; its "camera" entry may still change the rest.
+  const std::filesystem::path json =
+      std::filesystem::temp_directory_path() / ("pvr_use_camera_" + std::to_string(::getpid()) + ".json");
+  std::ofstream(json) << R"({"meshes": [{"file": ")" << path << R"(", "translate": [0, 0, 1], "use_camera": true}],
+                             "lights": [{"sun": [0, 1, 0], "irradiance": [1, 1, 1]}], "camera": {"ipd": 0.07}})";
+  const Scene fromJson = loadScene(json.string());
+  std::filesystem::remove(json);
+  EXPECT_TRUE(near(fromJson.rig.head.position, {0.5f, 0.5f, 4.0f}));
+  EXPECT_FLOAT_EQ(fromJson.rig.ipd, 0.07f);
+}
+
+// A camera under rotated and translated parents: its world pose is the product of the node
+// transforms (TRS and "matrix" nodes); an orthographic camera is passed over; no camera gives none.
+TEST(SceneImport, GltfCameraTakesItsNodesWorldTransform) {
+  namespace fs = std::filesystem;
+  const fs::path box = "/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf";
+  if (!fs::exists(box)) GTEST_SKIP() << "assimp-testmodels is not installed";
+  const fs::path dir = fs::temp_directory_path() / ("pvr_camera_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  for (const auto& entry : fs::directory_iterator(box.parent_path()))
+    fs::copy_file(entry.path(), dir / entry.path().filename(), fs::copy_options::overwrite_existing);
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(box));
+  const size_t first = doc["nodes"].size();
+  // rig (turned 90 degrees about +Y, at (0, 0, 4)) -> arm (a matrix: translate (0, 1, 0)) -> camera
+  // at (0, 0, 2) locally: world (2, 1, 4), looking down -X.
+  const float h = std::sqrt(0.5f);
+  doc["nodes"].push_back({{"name", "rig"}, {"rotation", {0, h, 0, h}}, {"translation", {0, 0, 4}}, {"children", {first + 1}}});
+  doc["nodes"].push_back({{"name", "arm"}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 1, 0, 1}},
+                          {"children", {first + 2}}});
+  doc["nodes"].push_back({{"name", "eye"}, {"translation", {0, 0, 2}}, {"camera", 1}});
+  doc["nodes"].push_back({{"name", "flat"}, {"camera", 0}});
+  doc["cameras"] = {{{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 9}}}},
+                    {{"type", "perspective"}, {"name", "walk"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}}};
+  doc["scenes"][0]["nodes"] = {first + 3, 0, first};
+  std::ofstream(dir / "rigged.gltf") << doc.dump();
+  Scene scene;
+  const std::optional<FileCamera> camera = importMeshFile((dir / "rigged.gltf").string(), scene);
+  ASSERT_TRUE(camera.has_value());
+  EXPECT_EQ(camera->name, "walk");
+  EXPECT_LT(length(camera->pose.position - Vec3(2, 1, 4)), 1e-5f);
+  EXPECT_LT(length(camera->pose.toWorldDir({0, 0, -1}) - Vec3(-1, 0, 0)), 1e-5f);
+  EXPECT_LT(length(camera->pose.toWorldDir({0, 1, 0}) - Vec3(0, 1, 0)), 1e-5f);
+  Scene plain;
+  EXPECT_FALSE(importMeshFile(box.string(), plain).has_value());
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace pvr
 

@@ -19,6 +19,8 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <cctype>
 #include <cstring>
@@ -378,9 +380,95 @@ void checkGltfRanges(const GltfFile& file, const std::string& path) {
   }
 }
 
+// A glTF node's local transform, column-major: its "matrix", or translation * rotation * scale.
+// False when malformed.
+using Matrix4 = std::array<double, 16>;
+Matrix4 multiply(const Matrix4& a, const Matrix4& b) {
+  Matrix4 m{};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      for (int k = 0; k < 4; ++k) m[c * 4 + r] += a[k * 4 + r] * b[c * 4 + k];
+  return m;
+}
+bool gltfNodeMatrix(const nlohmann::json& node, Matrix4& m) {
+  auto numbers = [&](const char* key, size_t count, std::array<double, 16>& out) {
+    if (!node.contains(key)) return true;
+    const nlohmann::json& a = node[key];
+    if (!a.is_array() || a.size() != count) return false;
+    for (size_t i = 0; i < count; ++i) {
+      if (!a[i].is_number()) return false;
+      out[i] = a[i].get<double>();
+    }
+    return true;
+  };
+  m = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  if (node.contains("matrix")) return numbers("matrix", 16, m);
+  std::array<double, 16> t{0, 0, 0}, r{0, 0, 0, 1}, sc{1, 1, 1};
+  if (!numbers("translation", 3, t) || !numbers("rotation", 4, r) || !numbers("scale", 3, sc)) return false;
+  const double len = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+  if (!(len > 0.0)) return false;
+  const double x = r[0] / len, y = r[1] / len, z = r[2] / len, w = r[3] / len;
+  const double rot[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),   // column 0
+                         2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),   // column 1
+                         2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < 3; ++row) m[c * 4 + row] = rot[c * 3 + row] * sc[c];
+  m[12] = t[0], m[13] = t[1], m[14] = t[2];
+  return true;
+}
+
+// The first perspective camera met walking the glTF's scene (its "scene", else the first) depth
+// first: glTF's camera sits at its node's origin looking down -Z with +Y up. The file's node tree
+// is read here because assimp moves a camera node's translation into the camera as well.
+std::optional<FileCamera> gltfCamera(const nlohmann::json& doc) {
+  using nlohmann::json;
+  if (!doc.is_object() || !doc.contains("nodes") || !doc["nodes"].is_array() || !doc.contains("scenes") ||
+      !doc["scenes"].is_array() || !doc.contains("cameras") || !doc["cameras"].is_array())
+    return std::nullopt;
+  const json &nodes = doc["nodes"], &cameras = doc["cameras"], &scenes = doc["scenes"];
+  const size_t sceneIndex = doc.contains("scene") && doc["scene"].is_number_unsigned() ? doc["scene"].get<size_t>() : 0;
+  if (sceneIndex >= scenes.size() || !scenes[sceneIndex].is_object() || !scenes[sceneIndex].contains("nodes") ||
+      !scenes[sceneIndex]["nodes"].is_array())
+    return std::nullopt;
+  std::vector<bool> visited(nodes.size(), false);  // a node in two places (or a cycle) is walked once
+  std::optional<FileCamera> found;
+  auto walk = [&](auto&& self, const json& index, const Matrix4& parent) -> void {
+    if (found || !index.is_number_unsigned() || index.get<size_t>() >= nodes.size()) return;
+    const size_t i = index.get<size_t>();
+    if (visited[i] || !nodes[i].is_object()) return;
+    visited[i] = true;
+    const json& node = nodes[i];
+    Matrix4 local;
+    if (!gltfNodeMatrix(node, local)) return;
+    const Matrix4 world = multiply(parent, local);
+    if (node.contains("camera") && node["camera"].is_number_unsigned() && node["camera"].get<size_t>() < cameras.size()) {
+      const json& camera = cameras[node["camera"].get<size_t>()];
+      if (camera.is_object() && camera.value("type", std::string()) == "perspective") {
+        const Vec3 position{float(world[12]), float(world[13]), float(world[14])};
+        const Vec3 forward{float(-world[8]), float(-world[9]), float(-world[10])}, up{float(world[4]), float(world[5]), float(world[6])};
+        if (isFinite(position) && isFinite(forward) && isFinite(up) && lengthSquared(cross(forward, up)) > 1e-12f) {
+          FileCamera c;
+          c.name = camera.contains("name") && camera["name"].is_string()   ? camera["name"].get<std::string>()
+                   : node.contains("name") && node["name"].is_string() ? node["name"].get<std::string>()
+                                                                         : "camera " + std::to_string(node["camera"].get<size_t>());
+          c.pose.position = position;
+          c.pose.orientation = lookAtOrientation(position, position + normalize(forward), normalize(up));
+          found = c;
+          return;
+        }
+      }
+    }
+    if (node.contains("children") && node["children"].is_array())
+      for (const json& child : node["children"]) self(self, child, world);
+  };
+  const Matrix4 identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  for (const json& root : scenes[sceneIndex]["nodes"]) walk(walk, root, identity);
+  return found;
+}
+
 }  // namespace
 
-void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& options) {
+std::optional<FileCamera> importMeshFile(const std::string& path, Scene& scene, const ImportOptions& options) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error("cannot open '" + path + "': no such file");
@@ -489,6 +577,15 @@ void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& 
     std::string meshName = mesh->mName.length ? mesh->mName.C_Str() : fs::path(path).filename().string();
     scene.addMesh(meshName, vertices, normals, uvs, indices, material);
   }
+  std::optional<FileCamera> camera = gltf ? gltfCamera(gltf->doc) : std::nullopt;
+  if (camera) {  // where the import puts the file: scale, rotate, translate
+    Pose& pose = camera->pose;
+    const Vec3 forward = options.rotation.rotate(pose.toWorldDir({0, 0, -1}) * options.scale);
+    const Vec3 up = options.rotation.rotate(pose.toWorldDir({0, 1, 0}) * options.scale);
+    pose.position = options.rotation.rotate(pose.position * options.scale) + options.translation;
+    pose.orientation = lookAtOrientation(pose.position, pose.position + normalize(forward), normalize(up));
+  }
+  return camera;
 }
 
 }  // namespace pvr

@@ -2,6 +2,7 @@
 // The host-side scene: indexed triangle meshes with per-triangle materials, the emitting
 // triangles, and the headset rig. Loaders (built-in scenes, assimp import, JSON scene files)
 // fill it; backends read it through SceneView.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -119,9 +120,20 @@ struct ImportOptions {
   bool importLights = true;    ///< the file's point, spot and directional lights (KHR_lights_punctual)
 };
 
+// The camera a mesh file carries: a glTF file's first perspective camera in its scene's node
+// tree, read from the glTF JSON (its node's world transform, then the import's). Only the pose: a
+// headset keeps its own field of view. Other formats' cameras are not read: Debian's assimp 5.2
+// counts a 3DS camera's node transform twice, and Dabrovic Sponza's camera lives only in its
+// keyframer tracks, which assimp does not apply (both come out at the wrong place).
+struct FileCamera {
+  std::string name;
+  Pose pose;
+};
+
 // A mesh file through assimp (.gltf, .glb, .obj with .mtl, and whatever else assimp reads).
-// Appends to `scene`; throws pvr::Error for a missing, unsupported or malformed file.
-void importMeshFile(const std::string& path, Scene& scene, const ImportOptions& options = {});
+// Appends to `scene`; returns the file's camera, if any; throws pvr::Error for a missing,
+// unsupported or malformed file.
+std::optional<FileCamera> importMeshFile(const std::string& path, Scene& scene, const ImportOptions& options = {});
 
 // A JSON scene file (see docs/scene-format.md) or, for any other extension, a mesh file.
 // The result is finalized. Throws pvr::Error with one line naming the problem.

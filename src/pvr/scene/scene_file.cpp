@@ -149,7 +149,8 @@ Scene loadJsonScene(const std::string& path) {
       for (const json& m : doc["meshes"]) {
         if (!m.is_object() || !m.contains("file") || !m["file"].is_string())
           throw Error("each entry of 'meshes' needs a \"file\"");
-        checkKeys(m, "a mesh entry", {"file", "scale", "rotate_deg", "translate", "emission_scale", "import_lights", "effect"});
+        checkKeys(m, "a mesh entry",
+                  {"file", "scale", "rotate_deg", "translate", "emission_scale", "import_lights", "effect", "use_camera"});
         ImportOptions opt;
         if (m.contains("import_lights")) {
           if (!m["import_lights"].is_boolean()) throw Error("mesh import_lights must be true or false");
@@ -165,7 +166,15 @@ Scene loadJsonScene(const std::string& path) {
         }
         std::filesystem::path file = expandEnvironment(m["file"].get<std::string>());
         const size_t materialsBefore = scene.materials().size();
-        importMeshFile((file.is_absolute() ? file : dir / file).string(), scene, opt);
+        const std::string meshPath = (file.is_absolute() ? file : dir / file).string();
+        const std::optional<FileCamera> camera = importMeshFile(meshPath, scene, opt);
+        if (m.contains("use_camera")) {  // the head where the file's camera is ("camera" below may still move it)
+          if (!m["use_camera"].is_boolean()) throw Error("mesh use_camera must be true or false");
+          if (m["use_camera"].get<bool>()) {
+            if (!camera) throw Error("mesh '" + meshPath + "' has no camera to use (use_camera: a glTF perspective camera)");
+            scene.rig.head = camera->pose;
+          }
+        }
         if (m.contains("effect")) {  // every material this file brought
           const EffectLevel level = effectLevel(m["effect"], "a mesh's \"effect\"");
           for (size_t i = materialsBefore; i < scene.materials().size(); ++i) scene.setEffect(uint32_t(i), level);
@@ -279,7 +288,7 @@ Scene loadScene(const std::string& pathOrBuiltin) {
   if (p.extension() == ".json") return loadJsonScene(pathOrBuiltin);
   Scene scene;
   scene.name = p.stem().string();
-  importMeshFile(pathOrBuiltin, scene);
+  const std::optional<FileCamera> camera = importMeshFile(pathOrBuiltin, scene);
   if (scene.lightTriangleCount() == 0 && scene.punctualLights().empty() && scene.triangleCount() > 0) {
     // Most asset-store files carry no light: a sun from above and behind the viewer, so that a
     // good file renders (JSON scenes say what lights them).
@@ -291,7 +300,12 @@ Scene loadScene(const std::string& pathOrBuiltin) {
     std::fprintf(stderr, "photonvr: note: '%s' has no light: lit by a default sun (3 W/m^2 from above)\n", pathOrBuiltin.c_str());
   }
   scene.finalize();
-  // A bare mesh file has no camera: look at it from in front (+Z), far enough to see all of it.
+  if (camera) {
+    scene.rig.head = camera->pose;
+    std::fprintf(stderr, "photonvr: note: '%s' is viewed from its camera '%s'\n", pathOrBuiltin.c_str(), camera->name.c_str());
+    return scene;
+  }
+  // A bare mesh file without a camera: look at it from in front (+Z), far enough to see all of it.
   Bounds3 b = scene.bounds();
   Vec3 center = (b.lower + b.upper) * 0.5f;
   scene.rig.head.position = center + Vec3(0.0f, 0.0f, 0.5f * b.extent().z + 1.2f * maxComponent(b.extent()));
