@@ -44,6 +44,7 @@ struct Variant {
   int photonBatches;  ///< a rolling photon map's slices (1: every photon every frame)
   bool freshNoise = true;  ///< new random numbers every frame (the default under TAA or the denoiser)
   PixelSampling sampling = PixelSampling::BlueNoise;
+  Boundary boundary = Boundary::Sphere;  ///< the estimate where surfaces meet walls or end (photon/boundary.h)
 };
 constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"TAA", false, true, 1},
@@ -57,7 +58,10 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"raw, white noise", false, false, 1, true, PixelSampling::White},
                                  {"TAA, white noise", false, true, 1, true, PixelSampling::White},
                                  {"denoise, white noise", true, false, 1, true, PixelSampling::White},
-                                 {"denoise + TAA, white noise", true, true, 1, true, PixelSampling::White}};
+                                 {"denoise + TAA, white noise", true, true, 1, true, PixelSampling::White},
+                                 // The estimate clipped at walls and edges (--boundary clipped) against the paper's sphere.
+                                 {"raw, clipped", false, false, 1, true, PixelSampling::BlueNoise, Boundary::Clipped},
+                                 {"denoise + TAA, clipped", true, true, 1, true, PixelSampling::BlueNoise, Boundary::Clipped}};
 
 // Flicker of shown frames a -> b where the reference does not change: the mean absolute change of
 // luminance over the pixels whose references differ by less than 2 % (and 0.002 absolute), over
@@ -197,6 +201,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       vo.temporal.enabled = v.taa;
       vo.photonBatches = v.photonBatches;
       vo.gather.sampling = v.sampling;
+      vo.gather.density.boundary = v.boundary;
       renderer->setFreshNoisePerFrame(v.freshNoise);
       std::vector<double> denoiseMs, frameMs, relMse, ssim, flickers, referenceFlickers, unexplained;
       std::vector<std::array<Image, 2>> shown(sampled.size());
@@ -251,7 +256,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"reference_flicker", mean(referenceFlickers)}, {"unexplained_flicker", un},
                       {"unexplained_flicker_of_raw", rawUnexplained > 0 ? un / rawUnexplained : 1.0},
                       {"fresh_noise", v.freshNoise},
-                      {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"}, {"denoise_ms", dn},
+                      {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"},
+                      {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"}, {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});
     }
@@ -272,6 +278,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       vo.denoise.enabled = v.denoise;
       vo.temporal.enabled = v.taa;
       vo.gather.sampling = v.sampling;
+      vo.gather.density.boundary = v.boundary;
       ReferenceError at[3];
       Image last, stillShown;
       std::vector<double> changes;  // after the still frames, moving: frame-to-frame change of the left eye
@@ -314,6 +321,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       }
       json.push_back({{"suite", "quality"}, {"scene", scene.name}, {"head", "still"}, {"variant", v.name},
                       {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"},
+                      {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"},
                       {"backend", renderer->name()}, {"device", renderer->deviceName()},
                       {"eye_size", {start.width, start.height}}, {"photons", 512 * 512},
                       {"radius", o.gather.density.radius}, {"frames", kStillFrames},

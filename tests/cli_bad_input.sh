@@ -40,6 +40,10 @@ echo '{"base": "cornell", "lights": [{"sky": [-1, 0, 0]}]}' >"$out/negative_sky.
 expect_error "radiance must not be negative" render "$out/negative_sky.json" "${small[@]}"
 echo '{"base": "cornell", "lights": [{"sky": [1, 1, 1], "aim_radius": 2}]}' >"$out/half_aimed_sky.json"
 expect_error "needs both aim_center and aim_radius" render "$out/half_aimed_sky.json" "${small[@]}"
+echo "{\"base\": \"cornell\", \"meshes\": [{\"file\": \"$data/box.obj\", \"use_camera\": true}]}" >"$out/no_camera.json"
+expect_error "has no camera to use" render "$out/no_camera.json" "${small[@]}"
+echo "{\"base\": \"cornell\", \"meshes\": [{\"file\": \"$data/box.obj\", \"use_camera\": 1}]}" >"$out/camera_flag.json"
+expect_error "use_camera must be true or false" render "$out/camera_flag.json" "${small[@]}"
 expect_error "photons must be" render cornell --photons 0 --eye-size 8x8
 expect_error "--backend must be" render cornell --backend gpu --eye-size 8x8
 expect_error "--kernel must be" render cornell --kernel fused --eye-size 8x8
@@ -78,6 +82,8 @@ expect_error "--cache-cell: the surface cache's cell must be between" render cor
 expect_error "--cache-cell: the surface cache's cell must be between" render cornell --backend cpu --density cache --cache-cell nan "${small[@]}"
 expect_error "--density: the surface cache shades full-resolution eyes" render cornell --backend cpu --density cache --foveated "${small[@]}"
 expect_error "--primary must be rays or raster" render cornell --backend cpu --primary gbuffer "${small[@]}"
+expect_error "--boundary must be sphere or clipped" render cornell --backend cpu --boundary planes "${small[@]}"
+expect_error "--density: the surface cache's cells mix points on both sides of a wall" render cornell --backend cpu --density cache --boundary clipped "${small[@]}"
 # The pre-pass without any Vulkan driver (the loader finds none): one line, before any frame.
 VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json \
   expect_error "--primary raster: no Vulkan driver found" render cornell --backend cpu --primary raster "${small[@]}"

@@ -74,6 +74,7 @@ struct RenderArgs {
   std::string radius;  // empty: 0.05 for the built-in scenes, else 0.4 % of the scene's bounding-box diagonal
   std::string map = "hashgrid";
   std::string estimator = "radius";
+  std::string boundary = "sphere";
   std::string kernel = "hybrid";
   std::string density = "pixel";
   std::string cacheCell;  // empty: kDefaultCacheCellFraction
@@ -145,6 +146,7 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     text("radius", "--radius", a.radius);
     text("map", "--map", a.map);
     text("estimator", "--estimator", a.estimator);
+    text("boundary", "--boundary", a.boundary);
     text("kernel", "--kernel", a.kernel);
     text("density", "--density", a.density);
     text("cache_cell", "--cache-cell", a.cacheCell);
@@ -196,6 +198,12 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--estimator", a.estimator, "Density estimation: radius (fixed radius, no heap) | knn (max-heap)")
       ->capture_default_str();
   cmd.add_option("--k", a.k, "Photons per kNN estimate (1..64)")->capture_default_str();
+  cmd.add_option("--boundary", a.boundary,
+                 "Estimates where a surface meets a wall: sphere (the paper's: the photons within r, over pi r^2) | "
+                 "clipped (probe rays find the walls and edges in reach: photons on or behind the nearest wall are "
+                 "left out, and the estimate is over the disc's area on the surface; corners and edges no longer "
+                 "darken)")
+      ->capture_default_str();
   cmd.add_option("--kernel", a.kernel,
                  "GPU eye pass: single (rays + estimate in one kernel) | hybrid (separate density kernel) | shared "
                  "(hybrid, the paper's Algorithm 1) | sorted (hybrid, gather points sorted by cell); same image")
@@ -283,6 +291,9 @@ RenderOptions toOptions(const RenderArgs& a, StereoRig& rig) {
   if (a.estimator == "radius") o.gather.density.estimator = Estimator::Radius;
   else if (a.estimator == "knn") o.gather.density.estimator = Estimator::Knn;
   else throw Error("--estimator must be radius or knn, got '" + a.estimator + "'");
+  if (a.boundary == "sphere") o.gather.density.boundary = Boundary::Sphere;
+  else if (a.boundary == "clipped") o.gather.density.boundary = Boundary::Clipped;
+  else throw Error("--boundary must be sphere or clipped, got '" + a.boundary + "'");
   o.gather.density.k = a.k;
   if (a.kernel == "single") o.kernel = DensityKernel::Single;
   else if (a.kernel == "hybrid") o.kernel = DensityKernel::Hybrid;
@@ -429,9 +440,10 @@ int runRender(const RenderArgs& a) {
   std::printf("scene %s: %u triangles, %u emitting, %zu point/spot/sun lights, %u textures; eyes %dx%d, IPD %.1f mm\n",
               scene.name.c_str(), scene.triangleCount(), scene.lightTriangleCount(), scene.punctualLights().size(),
               scene.textureCount(), rig.width, rig.height, rig.ipd * 1000.0f);
-  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s, %d spp, %d shadow rays per point (0: one per light), %s sampling, seed %u\n", options.photonsX,
+  std::printf("photons %ux%u, radius %g, map %s, estimator %s%s%s, %d spp, %d shadow rays per point (0: one per light), %s sampling, seed %u\n", options.photonsX,
               options.photonsY, options.gather.density.radius, a.map.c_str(), a.estimator.c_str(),
               options.gather.density.estimator == Estimator::Knn ? (" (k=" + std::to_string(a.k) + ")").c_str() : "",
+              options.gather.density.boundary == Boundary::Clipped ? " clipped at walls and edges" : "",
               options.gather.samplesPerPixel, options.gather.punctualShadowRays,
               options.gather.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white", options.gather.seed);
   std::printf("backend %s: %s%s\n", renderer->name().c_str(), renderer->deviceName().c_str(),

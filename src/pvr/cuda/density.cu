@@ -60,7 +60,7 @@ __global__ void __launch_bounds__(kTile* kTile) sharedDensityKernel(HashGridView
         if (estimating) {
           for (uint32_t k = 0; k < n; ++k) {
             float d2 = photonDistance2(gp.position, staged[k].position);
-            if (d2 <= searchR2 && photonFacesSurface(staged[k].direction, gp.normal)) {
+            if (d2 <= searchR2 && photonCounts(staged[k].position - gp.position, staged[k].direction, gp.normal, gp.wall)) {
               if (E == Estimator::Radius) sum += gp.photonContribution(staged[k]);
               else heap.offer(d2, base + k, searchR2);
             }
@@ -129,7 +129,8 @@ __global__ void warpPerPointDensityKernel(HashGridView map, float radius, Gather
       uint32_t first = uint32_t(cell + map.rowOffsets[row]);
       uint32_t end = map.cellStart[first + 3];
       for (uint32_t j = map.cellStart[first] + lane; j < end; j += 32) {
-        if (photonDistance2(gp.position, map.position(j)) <= r2 && photonFacesSurface(map.photons[j].direction, gp.normal))
+        const Vec3 at = map.position(j);
+        if (photonDistance2(gp.position, at) <= r2 && photonCounts(at - gp.position, map.photons[j].direction, gp.normal, gp.wall))
           sum += gp.photonContribution(map.photons[j]);
       }
     }

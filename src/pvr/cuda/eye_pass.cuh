@@ -53,9 +53,9 @@ struct GatherPointStore {
 #ifdef __CUDACC__
   __device__ void store(size_t i, const GatherPoint& p) const {
     planes[kPlaneRadiance][i] = make_float4(p.radiance.x, p.radiance.y, p.radiance.z, __uint_as_float(p.lobes));
-    planes[kPlaneWeight][i] = make_float4(p.weight.x, p.weight.y, p.weight.z, 0.0f);
-    planes[kPlanePosition][i] = make_float4(p.position.x, p.position.y, p.position.z, 0.0f);
-    planes[kPlaneNormal][i] = make_float4(p.normal.x, p.normal.y, p.normal.z, 0.0f);
+    planes[kPlaneWeight][i] = make_float4(p.weight.x, p.weight.y, p.weight.z, p.wall.x);
+    planes[kPlanePosition][i] = make_float4(p.position.x, p.position.y, p.position.z, p.wall.y);
+    planes[kPlaneNormal][i] = make_float4(p.normal.x, p.normal.y, p.normal.z, p.wall.z);
     if (p.lobes) lobe[i] = GatherPointLobe{p.wo, p.bsdf};
   }
   __device__ static Vec3 xyz(float4 v) { return {v.x, v.y, v.z}; }
@@ -65,10 +65,12 @@ struct GatherPointStore {
             __float_as_uint(r.w)};
   }
   __device__ GatherPoint load(size_t i) const {
-    const GatherPointCore c = coreAt(i);
+    const float4 r = planes[kPlaneRadiance][i], w = planes[kPlaneWeight][i], x = planes[kPlanePosition][i],
+                 n = planes[kPlaneNormal][i];
     GatherPoint p;
-    p.radiance = c.radiance, p.weight = c.weight, p.position = c.position, p.normal = c.normal, p.lobes = c.lobes;
-    if (c.lobes) {
+    p.radiance = xyz(r), p.weight = xyz(w), p.position = xyz(x), p.normal = xyz(n), p.lobes = __float_as_uint(r.w);
+    p.wall = {w.w, x.w, n.w};  // Boundary::Clipped'
+    if (p.lobes) {
       const GatherPointLobe l = lobe[i];
       p.wo = l.wo, p.bsdf = l.bsdf;
     }

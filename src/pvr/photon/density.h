@@ -13,10 +13,17 @@ namespace pvr {
 
 enum class Estimator : int { Radius = 0, Knn = 1 };
 
+// What the estimate's support is where a surface meets another (photon/boundary.h).
+enum class Boundary : int {
+  Sphere = 0,  ///< the paper's: photons within r in 3D, divided by pi r^2
+  Clipped = 1, ///< photons beyond the nearest wall left out, divided by the disc's area on the surface (walls, edges)
+};
+
 struct DensityParams {
   float radius = 0.05f;  ///< search radius (the maximum radius for kNN)
   Estimator estimator = Estimator::Radius;
   int k = 32;  ///< photons for kNN, 1..kMaxKnn
+  Boundary boundary = Boundary::Sphere;
 };
 
 // Knaus and Zwicker's (2011) progressive radius of pass `pass` (from 0): r_{i+1}^2 = r_i^2 (i + alpha)
@@ -29,6 +36,17 @@ inline float progressiveRadius(float first, int pass, float alpha) {
 
 // A photon counts towards a surface only if it arrived from the side the normal faces.
 PVR_HOST_DEVICE inline bool photonFacesSurface(Vec3 photonDirection, Vec3 n) { return dot(photonDirection, n) < 0.0f; }
+
+// Photons at or past this fraction of the way to the nearest wall lie on it or behind it.
+constexpr float kBeyondWall = 0.98f;
+
+// Whether a photon at `offset` from x (its position - x) that arrived along `direction` counts
+// towards the estimate at x with unit normal n: it arrived from the side n faces and lies on this
+// side of the nearest wall (`wall`: the wall's normal in the tangent plane, pointing into it, over
+// its distance; zero: no wall, the paper's sphere).
+PVR_HOST_DEVICE inline bool photonCounts(Vec3 offset, Vec3 direction, Vec3 n, Vec3 wall) {
+  return photonFacesSurface(direction, n) && dot(offset, wall) < kBeyondWall;
+}
 
 // What each photon adds to an estimate: its power, or its power weighted by a view-dependent
 // BSDF for its direction (gather.h's GatherPoint::photonContribution).
@@ -48,23 +66,25 @@ PVR_HOST_DEVICE Vec3 knnFluxDensity(const PhotonMap& map, const KnnHeap& heap, f
 }
 
 // Flux density sum(weigh(photon)) / (pi r^2) at x on a surface with unit normal n facing the
-// viewer; photons that arrived from behind the surface are ignored. With PhotonPower it is the
-// irradiance-like sum(dPhi) / (pi r^2): multiply by the diffuse BRDF (albedo / pi) for radiance.
+// viewer; photons that arrived from behind the surface, or lie beyond `wall` (photonCounts), are
+// ignored. With PhotonPower it is the irradiance-like sum(dPhi) / (pi r^2): multiply by the
+// diffuse BRDF (albedo / pi) for radiance.
 template <class PhotonMap, class Weigh = PhotonPower>
 PVR_HOST_DEVICE Vec3 estimateFluxDensity(const PhotonMap& map, Vec3 x, Vec3 n, const DensityParams& params,
-                                         const Weigh& weigh = Weigh()) {
+                                         const Weigh& weigh = Weigh(), Vec3 wall = Vec3{0, 0, 0}) {
   float r2 = params.radius * params.radius;
   if (params.estimator == Estimator::Radius) {
     Vec3 sum{0, 0, 0};
     map.search(x, r2, [&](uint32_t i, float, float&) {
       const Photon& p = map.photons[i];
-      if (photonFacesSurface(p.direction, n)) sum += weigh(p);
+      if (photonCounts(p.position - x, p.direction, n, wall)) sum += weigh(p);
     });
     return sum * (1.0f / (kPi * r2));
   }
   KnnHeap heap(params.k);
   map.search(x, r2, [&](uint32_t i, float d2, float& searchR2) {
-    if (photonFacesSurface(map.photons[i].direction, n)) heap.offer(d2, i, searchR2);
+    const Photon& p = map.photons[i];
+    if (photonCounts(p.position - x, p.direction, n, wall)) heap.offer(d2, i, searchR2);
   });
   return knnFluxDensity(map, heap, params.radius * params.radius, weigh);
 }

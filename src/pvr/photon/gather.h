@@ -9,6 +9,7 @@
 //  - ShadingMode::PhotonMapOnly: emission + everything else from the photon map (the main paper's
 //    formulation; the map then holds every photon including the direct ones).
 #include "pvr/camera/stereo_rig.h"
+#include "pvr/photon/boundary.h"
 #include "pvr/photon/density.h"
 #include "pvr/shading/primary_hits.h"
 #include "pvr/shading/scene_view.h"
@@ -91,6 +92,7 @@ struct GatherPoint {
   uint32_t lobes = 0;    ///< the BSDF lobes the estimate evaluates; 0: Lambertian, none evaluated
   Vec3 wo{0, 0, 0};      ///< towards where the path came from (lobes != 0)
   BsdfParams bsdf;       ///< (lobes != 0)
+  Vec3 wall{0, 0, 0};    ///< Boundary::Clipped: the nearest wall, whose photons the estimate leaves out (photonCounts)
   PVR_HOST_DEVICE bool needsEstimate() const { return !isBlack(weight); }
   // What a photon that reached the surface adds to the estimate before `weight` and 1 / (pi r^2).
   PVR_HOST_DEVICE Vec3 photonContribution(const Photon& p) const {
@@ -306,6 +308,17 @@ PVR_HOST_DEVICE PVR_NOINLINE Vec3 pathTracedRadiance(const SceneView& scene, con
   return sum;
 }
 
+// Boundary::Clipped: the point's estimate cut at the nearest wall and scaled by the share of its disc
+// that lies on the surface (photon/boundary.h; kNN takes the cut alone).
+template <class Intersector>
+PVR_HOST_DEVICE void clipAtBoundaries(const SceneView& scene, const Intersector& intersector, const GatherParams& params,
+                                 GatherPoint& point, CounterRng& rng) {
+  if (params.density.boundary != Boundary::Clipped || !point.needsEstimate()) return;
+  const WallProbe probe = probeWalls(scene, intersector, point.position, point.normal, params.density.radius, rng.uniform());
+  point.wall = probe.wall;
+  if (params.density.estimator == Estimator::Radius) point.weight *= 1.0f / probe.discShare;
+}
+
 // Follows the eye ray through mirrors and glass to a surface that gathers from the photon map.
 // `firstHit`, if given, is the ray's first intersection, already traced. `coneSpread` is the ray
 // cone's width per unit distance (a pixel's, for camera rays): it chooses the textures' level of
@@ -378,6 +391,7 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
       }
       out.position = sp.position;
       out.normal = nGeo;
+      clipAtBoundaries(scene, intersector, params, out, rng);
       break;
     }
     if (m.type == MaterialType::Microfacet) {
@@ -429,6 +443,7 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
         out.lobes = gathered;
         out.wo = wo;
         out.bsdf = b;
+        clipAtBoundaries(scene, intersector, params, out, rng);
         break;
       }
       // Three statements: the order of evaluation of arguments differs between g++ and nvcc.
@@ -453,7 +468,8 @@ template <class PhotonMap>
 PVR_HOST_DEVICE Vec3 finishGather(const PhotonMap& map, const GatherPoint& point, const DensityParams& density) {
   if (!point.needsEstimate()) return point.radiance;
   auto contribution = [&](const Photon& p) { return point.photonContribution(p); };
-  return point.radiance + point.weight * estimateFluxDensity(map, point.position, point.normal, density, contribution);
+  return point.radiance +
+         point.weight * estimateFluxDensity(map, point.position, point.normal, density, contribution, point.wall);
 }
 
 // Radiance arriving along one eye ray.

@@ -68,6 +68,9 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
     if (o.foveation.mask)
       throw OptionError(RenderOption::Density, "the surface cache shades full-resolution eyes: a foveated pass "
                                                "estimates at its mask's vertices (use --density pixel)");
+    if (d.boundary == Boundary::Clipped)
+      throw OptionError(RenderOption::Density, "the surface cache's cells mix points on both sides of a wall: "
+                                               "--boundary clipped estimates per pixel (use --density pixel)");
   }
   for (int e = 0; e < 2; ++e)
     for (float g : o.foveation.gaze[e])
