@@ -45,6 +45,34 @@ double clippedDiscShare(double d, double r) {
   return 1.0 - cap / (kPi * r * r);
 }
 
+// Every photon's first landing (no bounces), in a hash grid of cell r.
+HashGrid directPhotons(const CpuBackend& backend, float r) {
+  PhotonTraceParams tp;
+  tp.photonCount = 1u << 22;
+  tp.storeDirect = true;
+  tp.maxDepth = 1;
+  return HashGrid::build(backend.tracePhotons(tp), r);
+}
+
+// Photon-map-only radiance (red) at 32 points x = d along the line (d, y, -1.2 .. 1.2), each seen
+// from above and beside it, averaged.
+double meanRadiance(const CpuBackend& backend, const SceneView& view, const HashGrid& grid, float r, Boundary boundary,
+                    float d, float y) {
+  GatherParams params;
+  params.mode = ShadingMode::PhotonMapOnly;
+  params.density.radius = r;
+  params.density.boundary = boundary;
+  double sum = 0;
+  const int n = 32;
+  for (int k = 0; k < n; ++k) {
+    const Vec3 p{d, y, -1.2f + 2.4f * (k + 0.5f) / n}, eye = p + Vec3(0.6f, 1.0f, 0.1f);
+    CounterRng rng(1, uint32_t(k), 0);
+    const GatherPoint gp = traceToGatherPoint(view, backend.intersector(), params, Ray{eye, normalize(p - eye)}, rng);
+    sum += finishGather(grid.view(), gp, params.density).x;
+  }
+  return sum / n;
+}
+
 TEST(Boundary, ProbesFindTheWallsDistanceAndPlane) {
   FloorAndWall s;
   EmbreeIntersector intersector(s.scene);
@@ -77,33 +105,15 @@ TEST(Boundary, LitPlaneMeetingAWallKeepsItsIrradiance) {
   FloorAndWall s;
   CpuBackend backend(s.scene);
   const SceneView view = s.scene.view();
-  PhotonTraceParams tp;
-  tp.photonCount = 1u << 22;
-  tp.storeDirect = true;
-  tp.maxDepth = 1;
   const float r = 0.2f;
-  const HashGrid grid = HashGrid::build(backend.tracePhotons(tp), r);
+  const HashGrid grid = directPhotons(backend, r);
   const float expected = s.floorIrradiance() / kPi;
-  auto meanRadiance = [&](float d, Boundary boundary) {
-    GatherParams params;
-    params.mode = ShadingMode::PhotonMapOnly;
-    params.density.radius = r;
-    params.density.boundary = boundary;
-    double sum = 0;
-    const int n = 24;
-    for (int k = 0; k < n; ++k) {
-      const Vec3 p{d, 0.0f, -1.2f + 2.4f * (k + 0.5f) / n}, eye = p + Vec3(0.8f, 1.0f, 0.1f);
-      CounterRng rng(1, uint32_t(k), 0);
-      const GatherPoint gp = traceToGatherPoint(view, backend.intersector(), params, Ray{eye, normalize(p - eye)}, rng);
-      sum += finishGather(grid.view(), gp, params.density).x;
-    }
-    return sum / n;
-  };
   for (float d : {0.01f, 0.05f, 0.1f, 0.15f}) {
-    const double sphere = meanRadiance(d, Boundary::Sphere), walls = meanRadiance(d, Boundary::Clipped);
+    const double sphere = meanRadiance(backend, view, grid, r, Boundary::Sphere, d, 0.0f),
+                 clipped = meanRadiance(backend, view, grid, r, Boundary::Clipped, d, 0.0f);
     std::printf("wall at %.2f r: sphere %.4f, clipped %.4f of the floor's radiance (clipped disc %.4f)\n", d / r,
-                sphere / expected, walls / expected, clippedDiscShare(d, r));
-    EXPECT_NEAR(walls, expected, 0.03 * expected) << "wall at " << d;
+                sphere / expected, clipped / expected, clippedDiscShare(d, r));
+    EXPECT_NEAR(clipped, expected, 0.03 * expected) << "wall at " << d;
     if (d <= 0.05f) EXPECT_GT(std::fabs(sphere - expected), 0.05 * expected) << "the test sees the sphere's bias at " << d;
   }
   GatherParams sphere, walls;
@@ -136,28 +146,12 @@ TEST(Boundary, LitTableTopKeepsItsIrradianceUpToTheEdge) {
   scene.finalize();
   CpuBackend backend(scene);
   const SceneView view = scene.view();
-  PhotonTraceParams tp;
-  tp.photonCount = 1u << 22;
-  tp.storeDirect = true;
-  tp.maxDepth = 1;
   const float r = 0.2f;
-  const HashGrid grid = HashGrid::build(backend.tracePhotons(tp), r);
+  const HashGrid grid = directPhotons(backend, r);
   const float expected = 2.0f / kPi;
   for (float d : {0.02f, 0.08f, 0.14f}) {
-    double sphere = 0, clipped = 0;
-    const int n = 32;
-    for (int k = 0; k < n; ++k) {
-      const Vec3 p{d, 1.0f, -1.2f + 2.4f * (k + 0.5f) / n}, eye = p + Vec3(0.6f, 1.0f, 0.1f);
-      for (Boundary boundary : {Boundary::Sphere, Boundary::Clipped}) {
-        GatherParams params;
-        params.mode = ShadingMode::PhotonMapOnly;
-        params.density.radius = r;
-        params.density.boundary = boundary;
-        CounterRng rng(2, uint32_t(k), 0);
-        const GatherPoint gp = traceToGatherPoint(view, backend.intersector(), params, Ray{eye, normalize(p - eye)}, rng);
-        (boundary == Boundary::Sphere ? sphere : clipped) += finishGather(grid.view(), gp, params.density).x / n;
-      }
-    }
+    const double sphere = meanRadiance(backend, view, grid, r, Boundary::Sphere, d, 1.0f),
+                 clipped = meanRadiance(backend, view, grid, r, Boundary::Clipped, d, 1.0f);
     std::printf("edge at %.2f r: sphere %.4f (clipped disc %.4f), clipped %.4f of the top's radiance\n", d / r,
                 sphere / expected, clippedDiscShare(d, r), clipped / expected);
     EXPECT_NEAR(sphere, expected * clippedDiscShare(d, r), 0.03 * expected) << "edge at " << d;
