@@ -43,7 +43,7 @@ if [ "${3:-}" != --no-sanitizer ] && command -v compute-sanitizer >/dev/null; th
       --trajectory tests/data/gaze_pursuit.traj
     part "sanitizer_${tool}_denoised" compute-sanitizer --tool "$tool" --error-exitcode 9 \
       "$bundle/photonvr" render cornell "${small[@]}" --denoise --photon-batches 4 --taa --stereo gather \
-      --trajectory tests/data/gaze_pursuit.traj
+      --boundary clipped --trajectory tests/data/gaze_pursuit.traj
     part "sanitizer_${tool}_cached" compute-sanitizer --tool "$tool" --error-exitcode 9 \
       "$bundle/photonvr" render cornell-caustics "${small[@]}" --density cache --stereo gather --denoise \
       --trajectory tests/data/gaze_pursuit.traj
