@@ -201,8 +201,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
   cmd.add_option("--boundary", a.boundary,
                  "Estimates where a surface meets a wall: sphere (the paper's: the photons within r, over pi r^2) | "
                  "clipped (probe rays find the walls and edges in reach: photons on or behind the nearest wall are "
-                 "left out, and the estimate is over the disc's area on the surface; corners and edges no longer "
-                 "darken)")
+                 "left out, and the estimate is over the disc's area on the surface; docs/reference.md)")
       ->capture_default_str();
   cmd.add_option("--kernel", a.kernel,
                  "GPU eye pass: single (rays + estimate in one kernel) | hybrid (separate density kernel) | shared "

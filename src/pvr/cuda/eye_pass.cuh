@@ -69,7 +69,7 @@ struct GatherPointStore {
                  n = planes[kPlaneNormal][i];
     GatherPoint p;
     p.radiance = xyz(r), p.weight = xyz(w), p.position = xyz(x), p.normal = xyz(n), p.lobes = __float_as_uint(r.w);
-    p.wall = {w.w, x.w, n.w};  // Boundary::Clipped'
+    p.wall = {w.w, x.w, n.w};  // Boundary::Clipped's nearest wall
     if (p.lobes) {
       const GatherPointLobe l = lobe[i];
       p.wo = l.wo, p.bsdf = l.bsdf;

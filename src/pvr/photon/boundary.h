@@ -17,8 +17,8 @@
 // from its centre), and the estimate is scaled by pi r^2 / area (at most 8x). The nearest wall's
 // plane (from its geometric normal) leaves out the photons on it or behind it (photonCounts).
 //
-// Not corrected: photons on the far side of a convex edge that arrived travelling towards this
-// side, and kNN's area (the k-th distance is known only when estimating; kNN gets the wall's cut
+// Not corrected: photons on a second wall (a corner of two walls: only the nearest is cut), and
+// on the far side of a convex edge, that arrived travelling towards this side; kNN's area (the k-th distance is known only when estimating; kNN gets the wall's cut
 // alone). Cost: 8 short rays along the surface and 8 to 24 down per gather point.
 #include "pvr/photon/density.h"
 #include "pvr/shading/scene_view.h"
@@ -60,7 +60,7 @@ PVR_HOST_DEVICE WallProbe probeWalls(const SceneView& scene, const Intersector& 
         const float len = length(m);
         m = len > 1e-3f ? m * (1.0f / len) : dir;
         const float distance = dot(dir, m) * hit.t;  // along m to the plane through the hit
-        if (distance > 0.0f) {
+        if (distance > 1e-4f * radius) {  // a wall through x itself has no side to cut
           nearest = hit.t;
           out.wall = m * (1.0f / distance);
         }

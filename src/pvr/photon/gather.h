@@ -93,6 +93,7 @@ struct GatherPoint {
   Vec3 wo{0, 0, 0};      ///< towards where the path came from (lobes != 0)
   BsdfParams bsdf;       ///< (lobes != 0)
   Vec3 wall{0, 0, 0};    ///< Boundary::Clipped: the nearest wall, whose photons the estimate leaves out (photonCounts)
+  float discShare = 1;   ///< Boundary::Clipped: weight holds 1 / this, the disc's share on the surface (not stored on the GPU)
   PVR_HOST_DEVICE bool needsEstimate() const { return !isBlack(weight); }
   // What a photon that reached the surface adds to the estimate before `weight` and 1 / (pi r^2).
   PVR_HOST_DEVICE Vec3 photonContribution(const Photon& p) const {
@@ -101,7 +102,10 @@ struct GatherPoint {
   // What the denoiser divides the pixel by, so that it filters irradiance rather than texture: the
   // path's reflectance towards the eye (throughput times albedo; the base colour on a microfacet
   // surface). Zero where the path found no surface to gather on.
-  PVR_HOST_DEVICE Vec3 demodulationAlbedo() const { return lobes == 0 ? weight * kPi : weight * bsdf.baseColor; }
+  // Boundary::Clipped's area factor is not reflectance: it is taken out again.
+  PVR_HOST_DEVICE Vec3 demodulationAlbedo() const {
+    return (lobes == 0 ? weight * kPi : weight * bsdf.baseColor) * discShare;
+  }
 };
 
 // What the denoiser needs of a pixel besides its radiance: its emitted part (lights and sky seen,
@@ -316,7 +320,9 @@ PVR_HOST_DEVICE void clipAtBoundaries(const SceneView& scene, const Intersector&
   if (params.density.boundary != Boundary::Clipped || !point.needsEstimate()) return;
   const WallProbe probe = probeWalls(scene, intersector, point.position, point.normal, params.density.radius, rng.uniform());
   point.wall = probe.wall;
-  if (params.density.estimator == Estimator::Radius) point.weight *= 1.0f / probe.discShare;
+  if (params.density.estimator != Estimator::Radius) return;
+  point.weight *= 1.0f / probe.discShare;
+  point.discShare = probe.discShare;
 }
 
 // Follows the eye ray through mirrors and glass to a surface that gathers from the photon map.

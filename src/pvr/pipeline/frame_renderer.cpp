@@ -125,7 +125,7 @@ bool samePicture(const RenderOptions& a, const RenderOptions& b) {
   bool same = a.photonsX == b.photonsX && a.photonsY == b.photonsY && a.maxPhotonDepth == b.maxPhotonDepth &&
               a.map == b.map && a.density == b.density && a.cacheCellFraction == b.cacheCellFraction &&
               ga.density.radius == gb.density.radius && ga.density.estimator == gb.density.estimator &&
-              ga.density.k == gb.density.k && ga.mode == gb.mode && ga.maxSpecularDepth == gb.maxSpecularDepth &&
+              ga.density.k == gb.density.k && ga.density.boundary == gb.density.boundary && ga.mode == gb.mode && ga.maxSpecularDepth == gb.maxSpecularDepth &&
               ga.samplesPerPixel == gb.samplesPerPixel && ga.punctualShadowRays == gb.punctualShadowRays &&
               ga.seed == gb.seed && ga.sampling == gb.sampling && a.eyes[0] == b.eyes[0] && a.eyes[1] == b.eyes[1] && a.stereo == b.stereo &&
               a.foveation.mask == b.foveation.mask && a.temporal.enabled == b.temporal.enabled;

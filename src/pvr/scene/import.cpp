@@ -443,10 +443,13 @@ std::optional<FileCamera> gltfCamera(const nlohmann::json& doc) {
     const Matrix4 world = multiply(parent, local);
     if (node.contains("camera") && node["camera"].is_number_unsigned() && node["camera"].get<size_t>() < cameras.size()) {
       const json& camera = cameras[node["camera"].get<size_t>()];
-      if (camera.is_object() && camera.value("type", std::string()) == "perspective") {
+      if (camera.is_object() && camera.contains("type") && camera["type"].is_string() &&
+          camera["type"].get<std::string>() == "perspective") {
         const Vec3 position{float(world[12]), float(world[13]), float(world[14])};
         const Vec3 forward{float(-world[8]), float(-world[9]), float(-world[10])}, up{float(world[4]), float(world[5]), float(world[6])};
-        if (isFinite(position) && isFinite(forward) && isFinite(up) && lengthSquared(cross(forward, up)) > 1e-12f) {
+        const float forwardLength = length(forward), upLength = length(up);  // a node's scale may be tiny (mm to m)
+        if (isFinite(position) && forwardLength > 0.0f && upLength > 0.0f && std::isfinite(forwardLength) &&
+            std::isfinite(upLength) && lengthSquared(cross(forward / forwardLength, up / upLength)) > 1e-6f) {
           FileCamera c;
           c.name = camera.contains("name") && camera["name"].is_string()   ? camera["name"].get<std::string>()
                    : node.contains("name") && node["name"].is_string() ? node["name"].get<std::string>()

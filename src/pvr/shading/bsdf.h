@@ -80,15 +80,20 @@ struct BsdfParams {
   }
 
   // Kulla-Conty's lobe (the header's f_ms) is colour * scale * (1 - E(cos_o)) (1 - E(cos_i)).
+  // Sharp lobes lose little, and there the lobe would be a firefly source: its cosine-sampled
+  // weight grows as (1 - E(cos_i)) / (1 - E_avg), about 2600 at the sharpest alpha and grazing
+  // cos_i. So it fades in between 0.5 % and 1 % of average loss (roughness 0.2 to 0.25; weights
+  // at most about 20), and sharper lobes keep their single-scattering albedo (>= 99.5 % on average).
   struct MultipleScattering {
-    Vec3 color{0, 0, 0};  ///< F_ms: the metal's and the dielectric layer's, mixed by metallic
-    float scale = 0.0f;   ///< 1 / (pi (1 - E_avg)); 0: none (a smooth lobe, or seen from inside)
+    Vec3 color{0, 0, 0};  ///< F_ms: the metal's and the dielectric layer's, mixed by metallic (and the fade)
+    float scale = 0.0f;   ///< 1 / (pi (1 - E_avg)); 0: none (a sharp lobe, or seen from inside)
   };
   PVR_HOST_DEVICE MultipleScattering multipleScattering() const {
     MultipleScattering ms;
     if (etaO > etaI) return ms;  // inside a dielectric: transmission's share is not compensated
     const float averageAlbedo = ggxAverageAlbedo(alpha);
-    if (!(averageAlbedo < 1.0f - 1e-6f)) return ms;
+    const float fade = fminf((1.0f - averageAlbedo - 0.005f) * 200.0f, 1.0f);
+    if (!(fade > 0.0f)) return ms;
     ms.scale = kInvPi / (1.0f - averageAlbedo);
     auto furtherBounces = [&](float averageFresnel) {
       return averageFresnel * averageFresnel * averageAlbedo / (1.0f - averageFresnel * (1.0f - averageAlbedo));
@@ -97,8 +102,8 @@ struct BsdfParams {
     const Vec3 metal = baseColor + (Vec3(1.0f) - baseColor) * (1.0f / 21.0f);
     const float f90 = fminf(1.0f, 50.0f * specularF0);
     const float dielectric = specularF0 + (f90 - specularF0) * (1.0f / 21.0f);
-    ms.color = Vec3(furtherBounces(metal.x), furtherBounces(metal.y), furtherBounces(metal.z)) * metallic +
-               Vec3(furtherBounces(dielectric) * (1.0f - metallic));
+    ms.color = (Vec3(furtherBounces(metal.x), furtherBounces(metal.y), furtherBounces(metal.z)) * metallic +
+                Vec3(furtherBounces(dielectric) * (1.0f - metallic))) * fade;
     return ms;
   }
 
