@@ -1,13 +1,11 @@
 #pragma once
-// The density estimate where a surface meets a wall or ends (Boundary::Clipped). The paper's estimate
-// divides the photons within r by pi r^2, but next to a wall part of that disc is not on the
-// surface: no photon can land there, so floors darken towards corners (on the CPU Cornell box,
-// photon-map-only shading at r = 0.05, about 10 % in the 12-pixel band along its edges), while
-// photons on the wall itself that arrived travelling towards the floor's side are counted as if
-// they were on the floor.
-//
-// The same happens at convex edges (a table's rim, the open front of the Cornell box: on the CPU
-// box the band along its front edges is 10 % darker than the converged image).
+// The density estimate where a surface meets a wall or ends (Boundary::Clipped). The paper's
+// estimate divides the photons within r by pi r^2, but next to a wall part of that disc is not on
+// the surface: no photon can land there, so the estimate darkens towards corners, while photons
+// on the wall itself that arrived travelling towards the floor's side are counted as if they were
+// on the floor. The same holds at convex edges (a table's rim, the open front of the Cornell box:
+// on the CPU box, photon-map-only at r = 0.05, the band along its front edges is about 10 % darker
+// than the converged image).
 //
 // Probes find the walls: kWallProbes rays in the tangent plane, at a random rotation, each as long
 // as r. They start a quarter of r above the surface, so relief lower than that is not a wall.
@@ -17,9 +15,10 @@
 // from its centre), and the estimate is scaled by pi r^2 / area (at most 8x). The nearest wall's
 // plane (from its geometric normal) leaves out the photons on it or behind it (photonCounts).
 //
-// Not corrected: photons on a second wall (a corner of two walls: only the nearest is cut), and
-// on the far side of a convex edge, that arrived travelling towards this side; kNN's area (the k-th distance is known only when estimating; kNN gets the wall's cut
-// alone). Cost: 8 short rays along the surface and 8 to 24 down per gather point.
+// Not corrected: photons on a second wall (a corner of two walls: only the nearest is cut) or on
+// the far side of a convex edge that arrived travelling towards this side; kNN's area (the k-th
+// distance is known only when estimating; kNN gets the wall's cut alone). Cost: 8 short rays
+// along the surface and 8 to 24 down per gather point.
 #include "pvr/photon/density.h"
 #include "pvr/shading/scene_view.h"
 #include "pvr/util/sampling.h"
