@@ -662,65 +662,75 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
 int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
   int failures = 0;
   const int repeats = 20;
-  std::printf("\nRay throughput of the CUDA traversal (binary BVH from Embree, SAH + spatial splits; watertight "
-              "triangles), both eyes, one ray per pixel, %d runs (CUDA events; each after its own warm-up run): "
-              "Mrays/s at the median run time / at the p99 run time (p99 by nearest rank: the slowest under 100 "
-              "runs)\n\n"
-              "| scene | triangles | BVH nodes | refs | build ms | eye size | primary Mrays/s (median / p99) | "
-              "shadow Mrays/s (median / p99) | diffuse Mrays/s (median / p99) | check vs Embree |\n"
-              "|---|---|---|---|---|---|---|---|---|---|\n",
+  std::printf("\nRay throughput of the CUDA traversal, both eyes, one ray per pixel, %d runs (CUDA events; each "
+              "after its own warm-up run): Mrays/s at the median run time / at the p99 run time (p99 by nearest "
+              "rank: the slowest under 100 runs). Two BVH layouts, both built by Embree (SAH + spatial splits), "
+              "both with the same watertight triangle test: binary (64-byte nodes, 4 triangles a leaf) and "
+              "8-wide with 8-bit quantized child boxes (80-byte nodes, 3 triangles a leaf; the renderer's)\n\n"
+              "| scene | triangles | BVH | nodes | refs | MiB | build ms | SAH cost | eye size | primary Mrays/s "
+              "(median / p99) | shadow Mrays/s (median / p99) | diffuse Mrays/s (median / p99) | check vs Embree |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
               repeats);
   for (const std::string& name : splitList(args.raysScene)) {
     Scene scene = loadScene(name);
     StereoRig rig = benchRig(scene, args);
     CudaFrameBackend gpu(scene);
-    // One run per call, so that every run's time is kept (measureGpuRays reports the median of its runs).
-    GpuRayThroughput t;
-    std::vector<double> primaryMs, shadowMs, diffuseMs;
-    for (int r = 0; r < repeats; ++r) {
-      t = measureGpuRays(gpu, rig, 1);
-      primaryMs.push_back(t.primaryMs), shadowMs.push_back(t.shadowMs), diffuseMs.push_back(t.diffuseMs);
-    }
-    const LatencyStats primary = latencyStats(primaryMs), shadow = latencyStats(shadowMs),
-                       diffuse = latencyStats(diffuseMs);
-    // Check: the left eye's pixel-centre hits against Embree on the CPU, every 13th pixel.
     CpuBackend cpu(scene);
-    EyeCamera camera = rig.eye(Eye::Left);
-    size_t checked = 0, agree = 0;
-    for (size_t i = 0; i < t.leftPrimaryHits.size(); i += 13) {
-      int x = int(i % rig.width), y = int(i / rig.width);
-      Hit h;
-      bool hit = cpu.intersector().intersect(camera.generateRay(x + 0.5f, y + 0.5f), INFINITY, h);
-      const Hit& g = t.leftPrimaryHits[i];
-      ++checked;
-      if (hit == g.valid() && (!hit || h.primId == g.primId || std::fabs(h.t - g.t) <= 1e-4f * h.t)) ++agree;
+    const Bvh binary = Bvh::build(scene);
+    const WideBvh wide = WideBvh::build(scene);
+    for (int layout = 0; layout < 2; ++layout) {
+      const bool isWide = layout == 0;
+      GpuRayBench bench = isWide ? GpuRayBench(gpu, wide) : GpuRayBench(gpu, binary);
+      // One run per call, so that every run's time is kept (measure reports the median of its runs).
+      GpuRayThroughput t;
+      std::vector<double> primaryMs, shadowMs, diffuseMs;
+      for (int r = 0; r < repeats; ++r) {
+        t = bench.measure(rig, 1);
+        primaryMs.push_back(t.primaryMs), shadowMs.push_back(t.shadowMs), diffuseMs.push_back(t.diffuseMs);
+      }
+      const LatencyStats primary = latencyStats(primaryMs), shadow = latencyStats(shadowMs),
+                         diffuse = latencyStats(diffuseMs);
+      // Check: the left eye's pixel-centre hits against Embree on the CPU, every 13th pixel.
+      EyeCamera camera = rig.eye(Eye::Left);
+      size_t checked = 0, agree = 0;
+      for (size_t i = 0; i < t.leftPrimaryHits.size(); i += 13) {
+        int x = int(i % rig.width), y = int(i / rig.width);
+        Hit h;
+        bool hit = cpu.intersector().intersect(camera.generateRay(x + 0.5f, y + 0.5f), INFINITY, h);
+        const Hit& g = t.leftPrimaryHits[i];
+        ++checked;
+        if (hit == g.valid() && (!hit || h.primId == g.primId || std::fabs(h.t - g.t) <= 1e-4f * h.t)) ++agree;
+      }
+      double agreement = double(agree) / double(std::max<size_t>(checked, 1));
+      bool ok = agreement >= 0.999;
+      failures += ok ? 0 : 1;
+      const BvhBuildStats& s = isWide ? wide.stats() : binary.stats();
+      const double mib = double(isWide ? wide.memoryBytes() : binary.memoryBytes()) / (1024.0 * 1024.0);
+      const char* layoutName = isWide ? "8-wide, quantized" : "binary";
+      auto mrays = [](uint64_t rays, double ms) { return ms > 0 ? double(rays) / (ms * 1e3) : 0.0; };
+      std::printf("| %s | %u | %s | %u | %u | %.1f | %.0f | %.1f | %dx%d x2 | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f "
+                  "| %s (%.4f%% agree) |\n",
+                  name.c_str(), s.inputTriangles, layoutName, s.nodes, s.triangleReferences, mib, s.buildMs, s.sahCost,
+                  rig.width, rig.height, mrays(t.primaryRays, primary.p50), mrays(t.primaryRays, primary.p99),
+                  mrays(t.shadowRays, shadow.p50), mrays(t.shadowRays, shadow.p99), mrays(t.diffuseRays, diffuse.p50),
+                  mrays(t.diffuseRays, diffuse.p99), ok ? "ok" : "MISMATCH", 100.0 * agreement);
+      // *_ms stay the medians (now the nearest-rank p50) and *_mrays_s their throughputs; the objects
+      // "primary", "shadow" and "diffuse" hold the run times' mean, p50, p99 and max in ms.
+      json.push_back({{"suite", "rays"}, {"scene", name}, {"bvh", isWide ? "wide8" : "binary"},
+                      {"triangles", s.inputTriangles}, {"bvh_nodes", s.nodes}, {"bvh_refs", s.triangleReferences},
+                      {"bvh_mib", mib}, {"bvh_build_ms", s.buildMs}, {"sah_cost", s.sahCost},
+                      {"bvh_depth", s.maxDepth}, {"width", rig.width}, {"height", rig.height},
+                      {"repeats", repeats}, {"primary_rays", t.primaryRays}, {"primary_ms", primary.p50},
+                      {"shadow_rays", t.shadowRays}, {"shadow_ms", shadow.p50}, {"diffuse_rays", t.diffuseRays},
+                      {"diffuse_ms", diffuse.p50}, {"primary_mrays_s", mrays(t.primaryRays, primary.p50)},
+                      {"shadow_mrays_s", mrays(t.shadowRays, shadow.p50)},
+                      {"diffuse_mrays_s", mrays(t.diffuseRays, diffuse.p50)},
+                      {"primary_p99_mrays_s", mrays(t.primaryRays, primary.p99)},
+                      {"shadow_p99_mrays_s", mrays(t.shadowRays, shadow.p99)},
+                      {"diffuse_p99_mrays_s", mrays(t.diffuseRays, diffuse.p99)}, {"primary", primary},
+                      {"shadow", shadow}, {"diffuse", diffuse}, {"check_agreement", agreement}});
+      std::fflush(stdout);
     }
-    double agreement = double(agree) / double(std::max<size_t>(checked, 1));
-    bool ok = agreement >= 0.999;
-    failures += ok ? 0 : 1;
-    const BvhBuildStats& s = gpu.bvhStats();
-    auto mrays = [](uint64_t rays, double ms) { return ms > 0 ? double(rays) / (ms * 1e3) : 0.0; };
-    std::printf("| %s | %u | %u | %u | %.0f | %dx%d x2 | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f | %s (%.4f%% "
-                "agree) |\n",
-                name.c_str(), s.inputTriangles, s.nodes, s.triangleReferences, s.buildMs, rig.width, rig.height,
-                mrays(t.primaryRays, primary.p50), mrays(t.primaryRays, primary.p99), mrays(t.shadowRays, shadow.p50),
-                mrays(t.shadowRays, shadow.p99), mrays(t.diffuseRays, diffuse.p50), mrays(t.diffuseRays, diffuse.p99),
-                ok ? "ok" : "MISMATCH", 100.0 * agreement);
-    // *_ms stay the medians (now the nearest-rank p50) and *_mrays_s their throughputs; the objects
-    // "primary", "shadow" and "diffuse" hold the run times' mean, p50, p99 and max in ms.
-    json.push_back({{"suite", "rays"}, {"scene", name}, {"triangles", s.inputTriangles}, {"bvh_nodes", s.nodes},
-                    {"bvh_refs", s.triangleReferences}, {"bvh_build_ms", s.buildMs}, {"sah_cost", s.sahCost},
-                    {"width", rig.width}, {"height", rig.height}, {"repeats", repeats},
-                    {"primary_rays", t.primaryRays}, {"primary_ms", primary.p50}, {"shadow_rays", t.shadowRays},
-                    {"shadow_ms", shadow.p50}, {"diffuse_rays", t.diffuseRays}, {"diffuse_ms", diffuse.p50},
-                    {"primary_mrays_s", mrays(t.primaryRays, primary.p50)},
-                    {"shadow_mrays_s", mrays(t.shadowRays, shadow.p50)},
-                    {"diffuse_mrays_s", mrays(t.diffuseRays, diffuse.p50)},
-                    {"primary_p99_mrays_s", mrays(t.primaryRays, primary.p99)},
-                    {"shadow_p99_mrays_s", mrays(t.shadowRays, shadow.p99)},
-                    {"diffuse_p99_mrays_s", mrays(t.diffuseRays, diffuse.p99)}, {"primary", primary},
-                    {"shadow", shadow}, {"diffuse", diffuse}, {"check_agreement", agreement}});
-    std::fflush(stdout);
   }
   return failures;
 }

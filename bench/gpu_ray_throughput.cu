@@ -10,8 +10,9 @@ using namespace cuda;
 namespace {
 
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
-__global__ void primaryRaysKernel(BvhIntersector sceneIntersector, EyeCamera camera, Hit* hits) {
-  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+template <class Intersector>
+__global__ void primaryRaysKernel(Intersector sceneIntersector, EyeCamera camera, Hit* hits) {
+  const Intersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   Hit hit;
@@ -29,9 +30,10 @@ __device__ inline bool primaryPoint(const SceneView& scene, const EyeCamera& cam
   return true;
 }
 
-__global__ void shadowRaysKernel(SceneView scene, BvhIntersector sceneIntersector, EyeCamera camera, const Hit* hits,
+template <class Intersector>
+__global__ void shadowRaysKernel(SceneView scene, Intersector sceneIntersector, EyeCamera camera, const Hit* hits,
                                  uint8_t* occluded) {
-  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const Intersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   SurfacePoint sp;
@@ -46,9 +48,10 @@ __global__ void shadowRaysKernel(SceneView scene, BvhIntersector sceneIntersecto
   occluded[pixel] = intersector.occluded({origin, d / dist}, dist * (1.0f - 1e-3f)) ? 1 : 0;
 }
 
-__global__ void diffuseRaysKernel(SceneView scene, BvhIntersector sceneIntersector, EyeCamera camera, const Hit* hits,
+template <class Intersector>
+__global__ void diffuseRaysKernel(SceneView scene, Intersector sceneIntersector, EyeCamera camera, const Hit* hits,
                                   Hit* out) {
-  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const Intersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   SurfacePoint sp;
@@ -72,9 +75,10 @@ double median(std::vector<double> v) {
 }
 
 
-}  // namespace
 
-GpuRayThroughput measureGpuRays(CudaFrameBackend& backend, const StereoRig& rig, int repeats) {
+template <class Intersector>
+GpuRayThroughput measureRays(CudaFrameBackend& backend, const Intersector& sceneIntersector, const StereoRig& rig,
+                             int repeats) {
   const DeviceScene& scene = backend.deviceScene();
   cudaStream_t stream = backend.stream();
   GpuRayThroughput out;
@@ -92,16 +96,16 @@ GpuRayThroughput measureGpuRays(CudaFrameBackend& backend, const StereoRig& rig,
     for (int e = 0; e < 2; ++e) {
       EyeCamera camera = rig.eye(Eye(e));
       timer.start(stream);
-      launch("primary rays", primaryRaysKernel, grid, block, 0, stream, scene.intersector, camera, primary[e].data());
+      launch("primary rays", primaryRaysKernel<Intersector>, grid, block, 0, stream, sceneIntersector, camera, primary[e].data());
       timer.stop(stream);
       primaryMs += timer.ms();
       timer.start(stream);
-      launch("shadow rays", shadowRaysKernel, grid, block, 0, stream, scene.view, scene.intersector, camera,
+      launch("shadow rays", shadowRaysKernel<Intersector>, grid, block, 0, stream, scene.view, sceneIntersector, camera,
              primary[e].data(), occluded.data());
       timer.stop(stream);
       shadowMs += timer.ms();
       timer.start(stream);
-      launch("diffuse rays", diffuseRaysKernel, grid, block, 0, stream, scene.view, scene.intersector, camera,
+      launch("diffuse rays", diffuseRaysKernel<Intersector>, grid, block, 0, stream, scene.view, sceneIntersector, camera,
              primary[e].data(), secondary.data());
       timer.stop(stream);
       diffuseMs += timer.ms();
@@ -123,5 +127,44 @@ GpuRayThroughput measureGpuRays(CudaFrameBackend& backend, const StereoRig& rig,
   return out;
 }
 
+}  // namespace
+
+struct GpuRayBench::Impl {
+  CudaFrameBackend& backend;
+  DeviceBuffer<BvhNode> binaryNodes;
+  DeviceBuffer<WideBvhNode> wideNodes;
+  DeviceBuffer<BvhTriangle> triangles;
+  BvhIntersector binary;
+  WideBvhIntersector wide;
+  bool isWide = false;
+  explicit Impl(CudaFrameBackend& b) : backend(b) {}
+};
+
+GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const Bvh& bvh) : impl_(std::make_unique<Impl>(backend)) {
+  impl_->binaryNodes.upload(bvh.nodes().data(), bvh.nodes().size(), "BVH nodes");
+  impl_->triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
+  impl_->binary.bvh = {impl_->binaryNodes.data(), impl_->triangles.data(), uint32_t(bvh.nodes().size()),
+                       uint32_t(bvh.triangles().size())};
+  impl_->binary.alphaTest = backend.deviceScene().intersector.alphaTest;
+  impl_->binary.alphaScene = backend.deviceScene().view;
+}
+
+GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const WideBvh& bvh) : impl_(std::make_unique<Impl>(backend)) {
+  impl_->isWide = true;
+  if (!bvh.nodes().empty()) impl_->wideNodes.upload(bvh.nodes().data(), bvh.nodes().size(), "wide BVH nodes");
+  impl_->triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
+  impl_->wide.bvh = {impl_->wideNodes.data(), impl_->triangles.data(), uint32_t(bvh.nodes().size()),
+                     uint32_t(bvh.triangles().size())};
+  impl_->wide.alphaTest = backend.deviceScene().intersector.alphaTest;
+  impl_->wide.alphaScene = backend.deviceScene().view;
+}
+
+GpuRayBench::~GpuRayBench() = default;
+
+GpuRayThroughput GpuRayBench::measure(const StereoRig& rig, int repeats) {
+  PVR_CUDA_CHECK(cudaDeviceSynchronize());
+  return impl_->isWide ? measureRays(impl_->backend, impl_->wide, rig, repeats)
+                       : measureRays(impl_->backend, impl_->binary, rig, repeats);
+}
 
 }  // namespace pvr

@@ -3,8 +3,10 @@
 // light sample from each primary hit, and cosine-distributed diffuse rays from each primary hit
 // (the rays suite of `photonvr bench`). No CUDA header is needed to use it.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "pvr/accel/wide_bvh.h"
 #include "pvr/cuda/cuda_frame_backend.h"
 
 namespace pvr {
@@ -15,6 +17,20 @@ struct GpuRayThroughput {
   std::vector<Hit> leftPrimaryHits;                    ///< pixel-centre hits of the left eye, row-major
 };
 
-GpuRayThroughput measureGpuRays(CudaFrameBackend& backend, const StereoRig& rig, int repeats);
+// The rays of one BVH layout, uploaded beside the backend's scene (whose shading data the shadow
+// and diffuse rays use): the binary BVH and the 8-wide one side by side.
+class GpuRayBench {
+ public:
+  GpuRayBench(CudaFrameBackend& backend, const Bvh& bvh);
+  GpuRayBench(CudaFrameBackend& backend, const WideBvh& bvh);
+  ~GpuRayBench();
+  GpuRayBench(const GpuRayBench&) = delete;
+  GpuRayBench& operator=(const GpuRayBench&) = delete;
+  GpuRayThroughput measure(const StereoRig& rig, int repeats);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace pvr

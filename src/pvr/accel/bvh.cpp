@@ -3,9 +3,14 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <string>
+
+#include "pvr/accel/wide_bvh.h"
+#include "pvr/accel/wide_bvh_traversal.h"
 
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
@@ -20,8 +25,9 @@ struct BuildNode {
   bool leaf;
 };
 struct BuildInner : BuildNode {
-  BuildNode* children[2];
-  Bounds3 bounds[2];
+  unsigned childCount;
+  BuildNode* children[kWideBvhWidth];
+  Bounds3 bounds[kWideBvhWidth];
 };
 struct BuildLeaf : BuildNode {
   uint32_t count;
@@ -38,18 +44,20 @@ constexpr unsigned kMaxLeafSize = 4;
 void* createInner(RTCThreadLocalAllocator alloc, unsigned int childCount, void*) {
   auto* node = static_cast<BuildInner*>(rtcThreadLocalAlloc(alloc, sizeof(BuildInner), 16));
   node->leaf = false;
-  node->children[0] = node->children[1] = nullptr;
+  node->childCount = 0;
+  for (BuildNode*& c : node->children) c = nullptr;
   return node;
 }
 
 void setChildren(void* nodePtr, void** children, unsigned int childCount, void*) {
   auto* node = static_cast<BuildInner*>(nodePtr);
-  for (unsigned i = 0; i < childCount && i < 2; ++i) node->children[i] = static_cast<BuildNode*>(children[i]);
+  node->childCount = std::min(childCount, unsigned(kWideBvhWidth));
+  for (unsigned i = 0; i < node->childCount; ++i) node->children[i] = static_cast<BuildNode*>(children[i]);
 }
 
 void setBounds(void* nodePtr, const RTCBounds** bounds, unsigned int childCount, void*) {
   auto* node = static_cast<BuildInner*>(nodePtr);
-  for (unsigned i = 0; i < childCount && i < 2; ++i) {
+  for (unsigned i = 0; i < childCount && i < unsigned(kWideBvhWidth); ++i) {
     node->bounds[i].lower = {bounds[i]->lower_x, bounds[i]->lower_y, bounds[i]->lower_z};
     node->bounds[i].upper = {bounds[i]->upper_x, bounds[i]->upper_y, bounds[i]->upper_z};
   }
@@ -180,19 +188,15 @@ class Flattener {
   double rootArea_ = 1.0;
 };
 
-}  // namespace
-
-Bvh Bvh::build(const Scene& scene) {
-  SceneView v = scene.view();
-  return build(scene.vertices(), std::vector<uint32_t>(v.indices, v.indices + 3 * size_t(v.triangleCount)));
-}
-
-Bvh Bvh::build(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices) {
-  auto start = std::chrono::steady_clock::now();
+// Runs Embree's builder over the triangles and hands its tree (null when no triangle is finite)
+// and the root's box to `flatten` while the tree is alive.
+template <class Flatten>
+void buildWithEmbree(const BuildInput& input, unsigned branching, unsigned maxLeafSize, unsigned maxDepth,
+                     Flatten&& flatten) {
+  const std::vector<Vec3>& vertices = *input.vertices;
+  const std::vector<uint32_t>& indices = *input.indices;
   size_t triangleCount = indices.size() / 3;
   if (triangleCount >= (size_t(1) << 30)) throw Error("too many triangles for the GPU BVH: " + std::to_string(triangleCount));
-  BuildInput input{&vertices, &indices};
-
   // Spatial splits need room for the references they add.
   std::vector<RTCBuildPrimitive> prims(std::max<size_t>(2 * triangleCount, 1));
   Bounds3 rootBounds;
@@ -209,48 +213,239 @@ Bvh Bvh::build(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& i
     rootBounds.extend(b.lower);
     rootBounds.extend(b.upper);
   }
-
-  Bvh bvh;
-  bvh.stats_.inputTriangles = uint32_t(triangleCount);
   if (count == 0) {
-    Flattener(input, bvh.nodes_, bvh.triangles_, bvh.stats_).flattenRoot(nullptr, rootBounds);
-  } else {
-    const int threads = libraryThreadLimit();
-    RTCDevice device = rtcNewDevice(threads ? ("threads=" + std::to_string(threads)).c_str() : nullptr);
-    if (!device) throw Error("Embree: cannot create a device for the BVH build");
-    RTCBVH handle = rtcNewBVH(device);
-    RTCBuildArguments args = rtcDefaultBuildArguments();
-    args.byteSize = sizeof(args);
-    args.buildQuality = RTC_BUILD_QUALITY_HIGH;  // SAH with spatial splits
-    args.buildFlags = RTC_BUILD_FLAG_NONE;
-    args.maxBranchingFactor = 2;
-    args.maxDepth = kBvhMaxDepth;
-    args.sahBlockSize = 1;
-    args.minLeafSize = 1;
-    args.maxLeafSize = kMaxLeafSize;
-    args.traversalCost = 1.0f;
-    args.intersectionCost = 1.0f;
-    args.bvh = handle;
-    args.primitives = prims.data();
-    args.primitiveCount = count;
-    args.primitiveArrayCapacity = prims.size();
-    args.createNode = createInner;
-    args.setNodeChildren = setChildren;
-    args.setNodeBounds = setBounds;
-    args.createLeaf = createLeaf;
-    args.splitPrimitive = splitPrimitive;
-    args.userPtr = &input;
-    auto* root = static_cast<BuildNode*>(rtcBuildBVH(&args));
-    RTCError error = rtcGetDeviceError(device);
-    if (!root || error != RTC_ERROR_NONE) {
-      rtcReleaseBVH(handle);
-      rtcReleaseDevice(device);
-      throw Error("Embree: the BVH build failed (error " + std::to_string(int(error)) + ")");
-    }
-    Flattener(input, bvh.nodes_, bvh.triangles_, bvh.stats_).flattenRoot(root, rootBounds);
+    flatten(static_cast<const BuildNode*>(nullptr), rootBounds);
+    return;
+  }
+  const int threads = libraryThreadLimit();
+  RTCDevice device = rtcNewDevice(threads ? ("threads=" + std::to_string(threads)).c_str() : nullptr);
+  if (!device) throw Error("Embree: cannot create a device for the BVH build");
+  RTCBVH handle = rtcNewBVH(device);
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.byteSize = sizeof(args);
+  args.buildQuality = RTC_BUILD_QUALITY_HIGH;  // SAH with spatial splits
+  args.buildFlags = RTC_BUILD_FLAG_NONE;
+  args.maxBranchingFactor = branching;
+  args.maxDepth = maxDepth;
+  args.sahBlockSize = 1;
+  args.minLeafSize = 1;
+  args.maxLeafSize = maxLeafSize;
+  args.traversalCost = 1.0f;
+  args.intersectionCost = 1.0f;
+  args.bvh = handle;
+  args.primitives = prims.data();
+  args.primitiveCount = count;
+  args.primitiveArrayCapacity = prims.size();
+  args.createNode = createInner;
+  args.setNodeChildren = setChildren;
+  args.setNodeBounds = setBounds;
+  args.createLeaf = createLeaf;
+  args.splitPrimitive = splitPrimitive;
+  args.userPtr = const_cast<BuildInput*>(&input);
+  auto* root = static_cast<BuildNode*>(rtcBuildBVH(&args));
+  RTCError error = rtcGetDeviceError(device);
+  if (!root || error != RTC_ERROR_NONE) {
     rtcReleaseBVH(handle);
     rtcReleaseDevice(device);
+    throw Error("Embree: the BVH build failed (error " + std::to_string(int(error)) + ")");
   }
+  try {
+    flatten(static_cast<const BuildNode*>(root), rootBounds);
+  } catch (...) {
+    rtcReleaseBVH(handle);
+    rtcReleaseDevice(device);
+    throw;
+  }
+  rtcReleaseBVH(handle);
+  rtcReleaseDevice(device);
+}
+
+// Flattens Embree's 8-wide tree into quantized nodes (wide_bvh.h).
+class WideBvhFlattener {
+ public:
+  WideBvhFlattener(const BuildInput& in, std::vector<WideBvhNode>& nodes, std::vector<BvhTriangle>& tris, BvhBuildStats& stats)
+      : in_(in), nodes_(nodes), triangles_(tris), stats_(stats) {}
+
+  void flattenRoot(const BuildNode* root, const Bounds3& rootBounds) {
+    if (!root) return;  // no triangle: no node, and every ray misses
+    rootArea_ = std::max(surfaceArea(rootBounds), 1e-30f);
+    nodes_.push_back({});
+    std::vector<Child> children;
+    if (root->leaf) {
+      children.push_back({root, rootBounds});
+    } else {
+      const auto* inner = static_cast<const BuildInner*>(root);
+      for (unsigned c = 0; c < inner->childCount; ++c) children.push_back({inner->children[c], inner->bounds[c]});
+    }
+    stats_.sahCost = 1.0;
+    fill(0, children, 1);
+  }
+
+ private:
+  struct Child {
+    const BuildNode* node;
+    Bounds3 bounds;
+  };
+
+  void fill(uint32_t index, const std::vector<Child>& children, uint32_t depth) {
+    BvhBuildStats& stats = stats_;
+    stats.maxDepth = std::max(stats.maxDepth, depth);
+    if (depth > kWideBvhMaxDepth) throw Error("the wide BVH is deeper than its traversal stack: " + std::to_string(depth));
+    const std::array<int, kWideBvhWidth> slotOf = assignSlots(children);
+    std::array<int, kWideBvhWidth> childInSlot;
+    childInSlot.fill(-1);
+    for (size_t i = 0; i < children.size(); ++i) childInSlot[size_t(slotOf[i])] = int(i);
+
+    WideBvhNode node{};
+    Bounds3 box;
+    for (const Child& c : children) {
+      box.extend(c.bounds.lower);
+      box.extend(c.bounds.upper);
+    }
+    for (int a = 0; a < 3; ++a) {
+      const float lo = box.lower[a], hi = box.upper[a];
+      node.origin[a] = lo;
+      int e = -100;
+      if (hi > lo) e = std::clamp(int(std::ceil(std::log2(double(hi - lo) / 255.0))), -100, 100);
+      while (e < 100 && wideBvhPlane(255, wideBvhStep(e), lo) < hi) ++e;
+      node.exponent[a] = int8_t(e);
+    }
+    // Slots in order: inner children become consecutive nodes, leaves' triangles consecutive.
+    std::vector<std::pair<int, const BuildInner*>> inner;  // (slot, node)
+    node.childBase = uint32_t(nodes_.size());
+    node.triangleBase = uint32_t(triangles_.size());
+    for (int s = 0; s < kWideBvhWidth; ++s) {
+      if (childInSlot[size_t(s)] < 0) continue;  // empty: no leaf count, not inner
+      const Child& c = children[size_t(childInSlot[size_t(s)])];
+      quantize(node, s, c.bounds);
+      const double relArea = surfaceArea(c.bounds) / rootArea_;
+      if (c.node->leaf) {
+        const auto* leaf = static_cast<const BuildLeaf*>(c.node);
+        const uint32_t offset = uint32_t(triangles_.size()) - node.triangleBase;
+        if (leaf->count == 0 || leaf->count > kWideBvhMaxLeafSize || offset + leaf->count > 24)
+          throw Error("wide BVH: a leaf of " + std::to_string(leaf->count) + " triangles cannot be encoded");
+        node.leaf[s] = uint8_t((leaf->count << 5) | offset);
+        for (uint32_t i = 0; i < leaf->count; ++i) triangles_.push_back(triangle(leaf->prims[i]));
+        stats.leaves++;
+        stats.sahCost += relArea * leaf->count;
+      } else {
+        node.innerMask = uint8_t(node.innerMask | (1u << s));
+        inner.push_back({s, static_cast<const BuildInner*>(c.node)});
+        stats.sahCost += relArea;
+      }
+    }
+    nodes_.resize(nodes_.size() + inner.size());
+    nodes_[index] = node;
+    for (size_t k = 0; k < inner.size(); ++k) {
+      const BuildInner* child = inner[k].second;
+      std::vector<Child> grandChildren;
+      for (unsigned c = 0; c < child->childCount; ++c) grandChildren.push_back({child->children[c], child->bounds[c]});
+      fill(node.childBase + uint32_t(k), grandChildren, depth + 1);
+    }
+  }
+
+  // Slot bit a set: the child lies on the positive side of the node's centre along axis a. Greedy
+  // by how far each child lies towards each slot's corner direction.
+  static std::array<int, kWideBvhWidth> assignSlots(const std::vector<Child>& children) {
+    Bounds3 box;
+    for (const Child& c : children) {
+      box.extend(c.bounds.lower);
+      box.extend(c.bounds.upper);
+    }
+    const Vec3 centre = (box.lower + box.upper) * 0.5f;
+    struct Candidate {
+      float score;
+      int child, slot;
+    };
+    std::vector<Candidate> candidates;
+    for (size_t i = 0; i < children.size(); ++i) {
+      const Vec3 d = (children[i].bounds.lower + children[i].bounds.upper) * 0.5f - centre;
+      for (int s = 0; s < kWideBvhWidth; ++s) {
+        float score = 0.0f;
+        for (int a = 0; a < 3; ++a) score += ((s >> a) & 1) ? d[a] : -d[a];
+        candidates.push_back({score, int(i), s});
+      }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& x, const Candidate& y) { return x.score > y.score; });
+    std::array<int, kWideBvhWidth> slotOf;
+    slotOf.fill(-1);
+    unsigned usedSlots = 0;
+    for (const Candidate& c : candidates) {
+      if (slotOf[size_t(c.child)] >= 0 || ((usedSlots >> c.slot) & 1u)) continue;
+      slotOf[size_t(c.child)] = c.slot;
+      usedSlots |= 1u << c.slot;
+    }
+    return slotOf;
+  }
+
+  // Slot s's box on the node's grid, rounded outwards in the traversal's own arithmetic.
+  static void quantize(WideBvhNode& node, int s, const Bounds3& b) {
+    for (int a = 0; a < 3; ++a) {
+      const float origin = node.origin[a], step = wideBvhStep(node.exponent[a]);
+      double lo = std::floor((double(b.lower[a]) - double(origin)) / double(step));
+      double hi = std::ceil((double(b.upper[a]) - double(origin)) / double(step));
+      uint32_t qlo = uint32_t(std::clamp(lo, 0.0, 255.0)), qhi = uint32_t(std::clamp(hi, 0.0, 255.0));
+      while (qlo > 0 && wideBvhPlane(qlo, step, origin) > b.lower[a]) --qlo;
+      while (qhi < 255 && wideBvhPlane(qhi, step, origin) < b.upper[a]) ++qhi;
+      if (wideBvhPlane(qlo, step, origin) > b.lower[a] || wideBvhPlane(qhi, step, origin) < b.upper[a])
+        throw Error("wide BVH: a child box does not fit its node's grid");
+      node.lower[a][s] = uint8_t(qlo);
+      node.upper[a][s] = uint8_t(qhi);
+    }
+  }
+
+  BvhTriangle triangle(uint32_t prim) const {
+    BvhTriangle t{};
+    t.v0 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim)]];
+    t.v1 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 1]];
+    t.v2 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 2]];
+    t.primId = prim;
+    return t;
+  }
+
+  const BuildInput& in_;
+  std::vector<WideBvhNode>& nodes_;
+  std::vector<BvhTriangle>& triangles_;
+  BvhBuildStats& stats_;
+  double rootArea_ = 1.0;
+};
+
+}  // namespace
+
+Bvh Bvh::build(const Scene& scene) {
+  SceneView v = scene.view();
+  return build(scene.vertices(), std::vector<uint32_t>(v.indices, v.indices + 3 * size_t(v.triangleCount)));
+}
+
+Bvh Bvh::build(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices) {
+  auto start = std::chrono::steady_clock::now();
+  BuildInput input{&vertices, &indices};
+  Bvh bvh;
+  bvh.stats_.inputTriangles = uint32_t(indices.size() / 3);
+  buildWithEmbree(input, 2, kMaxLeafSize, kBvhMaxDepth, [&](const BuildNode* root, const Bounds3& rootBounds) {
+    Flattener(input, bvh.nodes_, bvh.triangles_, bvh.stats_).flattenRoot(root, rootBounds);
+  });
+  bvh.stats_.nodes = uint32_t(bvh.nodes_.size());
+  bvh.stats_.triangleReferences = uint32_t(bvh.triangles_.size());
+  bvh.stats_.buildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return bvh;
+}
+
+WideBvh WideBvh::build(const Scene& scene) {
+  SceneView v = scene.view();
+  return build(scene.vertices(), std::vector<uint32_t>(v.indices, v.indices + 3 * size_t(v.triangleCount)));
+}
+
+WideBvh WideBvh::build(const std::vector<Vec3>& vertices, const std::vector<uint32_t>& indices) {
+  auto start = std::chrono::steady_clock::now();
+  BuildInput input{&vertices, &indices};
+  WideBvh bvh;
+  bvh.stats_.inputTriangles = uint32_t(indices.size() / 3);
+  buildWithEmbree(input, kWideBvhWidth, kWideBvhMaxLeafSize, kWideBvhMaxDepth,
+                  [&](const BuildNode* root, const Bounds3& rootBounds) {
+                    WideBvhFlattener(input, bvh.nodes_, bvh.triangles_, bvh.stats_).flattenRoot(root, rootBounds);
+                  });
   bvh.stats_.nodes = uint32_t(bvh.nodes_.size());
   bvh.stats_.triangleReferences = uint32_t(bvh.triangles_.size());
   bvh.stats_.buildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

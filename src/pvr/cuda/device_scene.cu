@@ -5,7 +5,7 @@
 
 namespace pvr::cuda {
 
-void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
+void DeviceScene::upload(const Scene& scene, const WideBvh& bvh) {
   SceneView host = scene.view();
   size_t vertexCount = scene.vertices().size();
   vertices.upload(scene.vertices().data(), vertexCount, "scene vertices");
@@ -32,7 +32,7 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
     offset += level.size();
   }
   if (!deviceTextures.empty()) textures.upload(deviceTextures.data(), deviceTextures.size(), "texture views");
-  nodes.upload(bvh.nodes().data(), bvh.nodes().size(), "BVH nodes");
+  if (!bvh.nodes().empty()) nodes.upload(bvh.nodes().data(), bvh.nodes().size(), "BVH nodes");
   triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
   PVR_CUDA_CHECK(cudaDeviceSynchronize());
   view = host;

@@ -1,6 +1,6 @@
 #pragma once
 // The scene and its BVH on the GPU, for the shared algorithm code's device side.
-#include "pvr/accel/bvh_traversal.h"
+#include "pvr/accel/wide_bvh_traversal.h"
 #include "pvr/cuda/cuda_util.cuh"
 #include "pvr/photon/hash_grid.h"
 #include "pvr/photon/kd_tree.h"
@@ -8,6 +8,9 @@
 #include "pvr/scene/scene.h"
 
 namespace pvr::cuda {
+
+// The renderer's ray queries: the 8-wide quantized BVH (wide_bvh.h).
+using SceneIntersector = WideBvhIntersector;
 
 struct DeviceScene {
   DeviceBuffer<Vec3> vertices, normals, faceNormals;
@@ -18,12 +21,12 @@ struct DeviceScene {
   DeviceBuffer<Material> materials;
   DeviceBuffer<PunctualLight> punctualLights;
   DeviceBuffer<float> lightCdf;
-  DeviceBuffer<BvhNode> nodes;
+  DeviceBuffer<WideBvhNode> nodes;
   DeviceBuffer<BvhTriangle> triangles;
   SceneView view;
-  BvhIntersector intersector;
+  SceneIntersector intersector;
 
-  void upload(const Scene& scene, const Bvh& bvh);
+  void upload(const Scene& scene, const WideBvh& bvh);
 };
 
 }  // namespace pvr::cuda

@@ -11,9 +11,9 @@ namespace {
 
 // The paper's "single" scheme: eye ray and estimate in one kernel.
 template <class Map, Estimator E, StereoRole R>
-__global__ void singleKernel(SceneView scene, BvhIntersector sceneIntersector, Map map, GatherParams params,
+__global__ void singleKernel(SceneView scene, SceneIntersector sceneIntersector, Map map, GatherParams params,
                              EyeCamera camera, Eye eye, StereoReuseView reuse, EyeOutputs out) {
-  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   params.density.estimator = E;  // compile-time estimator: the radius kernel carries no heap
@@ -31,9 +31,9 @@ __global__ void singleKernel(SceneView scene, BvhIntersector sceneIntersector, M
 
 // Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
 template <StereoRole R>
-__global__ void eyeRaysKernel(SceneView scene, BvhIntersector sceneIntersector, GatherParams params, EyeCamera camera,
+__global__ void eyeRaysKernel(SceneView scene, SceneIntersector sceneIntersector, GatherParams params, EyeCamera camera,
                               Eye eye, int sample, StereoReuseView reuse, GatherPointStore points, EyeOutputs out) {
-  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   size_t pixel = size_t(y) * camera.width + x;

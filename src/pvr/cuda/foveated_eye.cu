@@ -39,11 +39,11 @@ struct VertexInUse {
 constexpr int kVertexBlock = 128;
 
 template <StereoRole R>
-__global__ void vertexRaysKernel(SceneView scene, BvhIntersector sceneIntersector, GatherParams params, EyeCamera camera,
+__global__ void vertexRaysKernel(SceneView scene, SceneIntersector sceneIntersector, GatherParams params, EyeCamera camera,
                                  Eye eye, DeviceMaskView mask, int gazeX, int gazeY, const uint32_t* list,
                                  const uint32_t* listed, StereoReuseView reuse, EyeOutputs out, GatherPointStore points,
                                  float* inverseDepths) {
-  const BvhIntersector intersector = withSharedStack<kVertexBlock>(sceneIntersector);
+  const SceneIntersector intersector = withSharedStack<kVertexBlock>(sceneIntersector);
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= *listed) return;
   uint32_t vertex = list[i];

@@ -19,9 +19,9 @@ PVR_HOST_DEVICE inline float floatFromOrdered(int i) {
 
 constexpr int kPhotonBlock = 128;
 
-__global__ void tracePhotonsKernel(SceneView scene, BvhIntersector sceneIntersector, PhotonTraceParams params,
+__global__ void tracePhotonsKernel(SceneView scene, SceneIntersector sceneIntersector, PhotonTraceParams params,
                                    uint32_t first, uint32_t n, Photon* slots, uint32_t* counts, int* bounds) {
-  const BvhIntersector intersector = withSharedStack<kPhotonBlock>(sceneIntersector);
+  const SceneIntersector intersector = withSharedStack<kPhotonBlock>(sceneIntersector);
   uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   Bounds3 b;
   if (i < n) {

@@ -5,9 +5,9 @@ namespace {
 
 // Scatter: each left pixel's reusable surface, if the right eye sees it, lands on one right pixel;
 // the nearest one per pixel wins.
-__global__ void scatterKernel(SceneView scene, BvhIntersector sceneIntersector, const SurfaceRecord* surfaces,
+__global__ void scatterKernel(SceneView scene, SceneIntersector sceneIntersector, const SurfaceRecord* surfaces,
                               int sourceWidth, int sourceHeight, EyeCamera target, unsigned long long* scattered) {
-  const BvhIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(sourceWidth, sourceHeight, x, y)) return;
   uint32_t source = uint32_t(y) * uint32_t(sourceWidth) + uint32_t(x);
