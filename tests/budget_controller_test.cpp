@@ -368,6 +368,39 @@ TEST(BudgetController, ProfilesRoundTripAndBadOnesAreRefused) {
   EXPECT_THROW(BudgetController(twoGroups(), paramsFor(std::nan("")), RenderOptions(), &kMask), Error);
 }
 
+// `--budget-ms display`: the display's period drops from 11.1 ms (90 Hz) to 8.3 ms (120 Hz) and
+// rises to 22.2 ms (45 Hz, a runtime's reprojection mode). Within a second of each change the
+// frames keep to the new budget, and each frame is counted against the budget of its decision.
+TEST(BudgetController, FollowsTheDisplaysPeriod) {
+  BudgetController c(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const std::vector<TraceFrame> trace = walkTrace(900, 900, 900, 1.0, 1, 0.02, 5);
+  ControlLog log;
+  std::vector<double> ms;
+  for (size_t f = 0; f < trace.size(); ++f) {
+    if (f == 300) c.setBudget(1000.0 / 120.0);
+    if (f == 600) c.setBudget(1000.0 / 45.0);
+    c.setBudget(0.0);  // unknown (a runtime before its first frame): ignored
+    const ControlDecision d = c.decide(double(f) * kFrameMs);
+    EXPECT_EQ(d.budgetMs, f < 300 ? kFrameMs : (f < 600 ? 1000.0 / 120.0 : 1000.0 / 45.0)) << f;
+    const ControlCosts costs = frameCosts(c, d.setting, trace[f]);
+    log.add(d, costs.total(), costs);
+    ms.push_back(costs.total());
+    c.observe(costs);
+  }
+  auto window = [&](size_t from, size_t to) { return latencyStats(std::vector<double>(ms.begin() + long(from), ms.begin() + long(to))); };
+  EXPECT_LE(window(90, 300).p99, kFrameMs);
+  EXPECT_LE(window(390, 600).p99, 1000.0 / 120.0);
+  EXPECT_LE(window(690, 900).p99, 1000.0 / 45.0);
+  // The slower display leaves room, which the controller takes back: more work per frame.
+  EXPECT_GT(window(800, 900).mean, 1.3 * window(200, 300).mean);
+  size_t over = 0;
+  for (size_t f = 0; f < ms.size(); ++f) over += ms[f] > (f < 300 ? kFrameMs : (f < 600 ? 1000.0 / 120.0 : 1000.0 / 45.0));
+  EXPECT_EQ(log.framesOverTheirBudget(), over);
+  const nlohmann::json j = log.toJson(c);
+  EXPECT_EQ(j["frames_over_budget"].get<size_t>(), over);
+  EXPECT_EQ(j["frames"][450]["budget_ms"].get<double>(), 1000.0 / 120.0);
+}
+
 TEST(BudgetController, LogsEveryFrame) {
   BudgetController c(twoGroups(), paramsFor(5.5), RenderOptions(), &kMask);
   const std::vector<TraceFrame> trace = walkTrace(300, 100, 200, 3.0, 20, 0.02, 9);

@@ -95,6 +95,9 @@ expect_error "--budget-ms is for --trajectory" render cornell --backend cpu --bu
 printf '0 0.5 1  0 0 0 1  0.5 0.5\n' >"$out/one.traj"
 expect_error "--budget-ms must be a positive number" render cornell --backend cpu --budget-ms -2 --trajectory "$out/one.traj" "${small[@]}"
 expect_error "--budget-ms must be a positive number" render cornell --backend cpu --budget-ms nan --trajectory "$out/one.traj" "${small[@]}"
+expect_error "--budget-ms must be a positive number of milliseconds (at most 10000) or 'display'" render cornell --backend cpu \
+  --budget-ms 11ms --trajectory "$out/one.traj" "${small[@]}"
+expect_error "--budget-ms display needs a display" render cornell --backend cpu --budget-ms display --trajectory "$out/one.traj" "${small[@]}"
 expect_error "cannot open controller profile" render cornell --backend cpu --budget-ms 11.1 --controller-profile "$out/none.json" \
   --trajectory "$out/one.traj" "${small[@]}"
 echo '{"error": {"top": 0.1}}' >"$out/short_profile.json"

@@ -31,4 +31,9 @@ tr -d ' \n' <"$out/budget.json" >"$out/flat"
 grep -q '"controller":{"budget_ms":500' "$out/flat" || fail "no controller in the statistics"
 grep -q '"change":"start"' "$out/flat" || fail "no per-frame decisions"
 grep -q "controller: budget 500.00 ms" "$out/log" || fail "no controller summary"
+# --budget-ms display: the budget is the display's period, here the offscreen slot of 2 Hz.
+"$exe" xr --offscreen --backend cpu --eye-size 48x40 --frames 6 --warmup 1 --refresh 2 --handover none \
+  --budget-ms display --stats "$out/display.json" >"$out/log" 2>&1 || { cat "$out/log"; fail "exit code $? under --budget-ms display"; }
+tr -d ' \n' <"$out/display.json" | grep -q '"controller":{"budget_ms":500' || { cat "$out/display.json"; fail "the budget is not the display's period"; }
+grep -q "controller: budget 500.00 ms" "$out/log" || fail "no controller summary under --budget-ms display"
 echo "offscreen loop ok"

@@ -108,13 +108,14 @@ struct RenderArgs {
   std::string acuity = "linear";  // the mask made at start under --foveated
   std::string settings;           // JSON settings file (the viewer writes them)
   std::optional<Pose> head;       // from the settings file
-  double budgetMs = 0;            // > 0: the budget controller holds each frame under it
+  std::string budget;             // --budget-ms: milliseconds or "display"; empty: no controller
   std::string controllerProfile;  // its calibrated profile (empty: the generic model)
 };
 
 void addBudgetOptions(CLI::App& cmd, RenderArgs& a) {
-  cmd.add_option("--budget-ms", a.budgetMs,
-                 "Frame budget in ms (11.1 at 90 Hz): the controller chooses photons, radius, foveation, denoiser and "
+  cmd.add_option("--budget-ms", a.budget,
+                 "Frame budget in ms (11.1 at 90 Hz), or 'display' for the display's frame period (xr: the runtime's; "
+                 "view: the monitor's refresh): the controller chooses photons, radius, foveation, denoiser and "
                  "each effect group's level per frame to keep the p99 frame time under it (docs/ray-vr.md)");
   cmd.add_option("--controller-profile", a.controllerProfile,
                  "The controller's calibrated cost and quality model (from `bench --suite effects --profile-out`; "
@@ -448,12 +449,15 @@ int runRender(const RenderArgs& a) {
   std::printf("backend %s: %s%s\n", renderer->name().c_str(), renderer->deviceName().c_str(),
               renderer->name() == "cuda" ? (", " + std::string(densityKernelName(options.kernel)) + " kernel").c_str() : "");
   const char* names[2] = {"left", "right"};
-  if (a.budgetMs != 0 && trajectory.empty()) throw Error("--budget-ms is for --trajectory (and xr, view)");
+  const BudgetSpec budget = parseBudget(a.budget);
+  if (budget.enabled() && trajectory.empty()) throw Error("--budget-ms is for --trajectory (and xr, view)");
+  if (budget.followsDisplay)
+    throw Error("--budget-ms display needs a display (xr or view); render --trajectory has none: give milliseconds");
   if (!trajectory.empty()) {  // one frame per pose, PREFIX_NNNN_left/right
     double totalMs = 0;
     std::optional<FoveationMask> controlMask;
     std::unique_ptr<BudgetController> controller =
-        a.budgetMs != 0 ? makeBudgetController(a.budgetMs, a.controllerProfile, scene, options, rig, a.acuity, controlMask)
+        budget.enabled() ? makeBudgetController(budget, a.controllerProfile, scene, options, rig, a.acuity, controlMask)
                        : nullptr;
     ControlLog control;
     const auto start = std::chrono::steady_clock::now();
@@ -919,7 +923,7 @@ int runCli(int argc, char** argv, CliRun run) {
       l->exposure = a->exposure;
       l->sceneName = a->scene;
       l->acuity = a->acuity;
-      l->budgetMs = a->budgetMs;
+      l->budget = a->budget;
       l->controllerProfile = a->controllerProfile;
       if (l->cudaCopy != "buffer" && l->cudaCopy != "image") throw Error("--cuda-copy must be buffer or image, got '" + l->cudaCopy + "'");
       if (!(l->nearZ > 0.0f) || !std::isfinite(l->nearZ)) throw Error("--near must be a positive number of metres");

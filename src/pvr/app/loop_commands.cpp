@@ -87,12 +87,31 @@ void writeJson(const std::string& path, const nlohmann::json& j) {
   out << j.dump(2) << "\n";
 }
 
-std::unique_ptr<BudgetController> makeBudgetController(double budgetMs, const std::string& profilePath, const Scene& scene,
+BudgetSpec parseBudget(const std::string& text) {
+  BudgetSpec spec;
+  if (text.empty()) return spec;
+  if (text == "display") {
+    spec.ms = 1000.0 / 90.0;
+    spec.followsDisplay = true;
+    return spec;
+  }
+  size_t used = 0;
+  double ms = 0;
+  try {
+    ms = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !(ms > 0.0) || !std::isfinite(ms) || ms > 10000.0)
+    throw Error("--budget-ms must be a positive number of milliseconds (at most 10000) or 'display', got '" + text + "'");
+  spec.ms = ms;
+  return spec;
+}
+
+std::unique_ptr<BudgetController> makeBudgetController(const BudgetSpec& budget, const std::string& profilePath, const Scene& scene,
                                                        const RenderOptions& options, const StereoRig& rig,
                                                        const std::string& acuity, std::optional<FoveationMask>& mask) {
-  if (budgetMs == 0) return nullptr;
-  if (!(budgetMs > 0.0) || !std::isfinite(budgetMs) || budgetMs > 10000.0)
-    throw Error("--budget-ms must be a positive number of milliseconds (at most 10000)");
+  if (!budget.enabled()) return nullptr;
   const ControlProfile profile = profilePath.empty() ? ControlProfile::generic(scene.effectGroupNames())
                                                      : ControlProfile::load(profilePath, scene.effectGroupNames());
   const FoveationMask* fovea = options.foveation.mask;
@@ -103,7 +122,7 @@ std::unique_ptr<BudgetController> makeBudgetController(double budgetMs, const st
     fovea = &*mask;
   }
   BudgetControllerParams params;
-  params.budgetMs = budgetMs;
+  params.budgetMs = budget.ms;
   params.foveationAvailable = fovea != nullptr;
   return std::make_unique<BudgetController>(profile, params, options, fovea);
 }
@@ -194,8 +213,9 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                 run["handover"].get<std::string>().c_str());
     std::optional<FoveationMask> controlMask;
     std::unique_ptr<BudgetController> controller = makeBudgetController(
-        args.budgetMs, args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
+        parseBudget(args.budget), args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
+    lo.budgetFollowsDisplay = parseBudget(args.budget).followsDisplay;
     stats = runLoop(presenter);
     auto skipWarmup = [&](std::vector<double> v) {
       if (v.size() > args.warmup) v.erase(v.begin(), v.begin() + long(args.warmup));
@@ -241,8 +261,9 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                 info.handOver.c_str(), info.space.c_str());
     std::optional<FoveationMask> controlMask;
     std::unique_ptr<BudgetController> controller = makeBudgetController(
-        args.budgetMs, args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
+        parseBudget(args.budget), args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
+    lo.budgetFollowsDisplay = parseBudget(args.budget).followsDisplay;
     stats = runLoop(presenter);
     run["presenter"] = "openxr";
     run["runtime"] = info.runtime;
@@ -278,6 +299,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
   vs.map = o.map == PhotonMapKind::KdTree;
   vs.estimator = o.gather.density.estimator == Estimator::Knn;
   vs.k = o.gather.density.k;
+  vs.clippedBoundary = o.gather.density.boundary == Boundary::Clipped;
   vs.kernel = int(o.kernel == DensityKernel::Single ? 0 : o.kernel == DensityKernel::Hybrid ? 1 : o.kernel == DensityKernel::SharedMemory ? 2 : 3);
   vs.stereo = o.stereo == StereoMode::Separate ? 0 : o.stereo == StereoMode::Scatter ? 1 : 2;
   vs.foveated = o.foveation.mask != nullptr;
@@ -313,6 +335,7 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                         {"map", s.map ? "kdtree" : "hashgrid"},
                         {"estimator", s.estimator ? "knn" : "radius"},
                         {"k", s.k},
+                        {"boundary", s.clippedBoundary ? "clipped" : "sphere"},
                         {"kernel", kernels[s.kernel]},
                         {"stereo", stereo[s.stereo]},
                         {"foveated", s.foveated},
@@ -342,8 +365,9 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                 setup.rig.width, setup.rig.height);
     std::optional<FoveationMask> controlMask;
     std::unique_ptr<BudgetController> controller = makeBudgetController(
-        args.budgetMs, args.controllerProfile, *setup.scene, current, renderer.rig(), args.acuity, controlMask);
+        parseBudget(args.budget), args.controllerProfile, *setup.scene, current, renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
+    lo.budgetFollowsDisplay = parseBudget(args.budget).followsDisplay;
     FrameStats stats = FrameLoop(renderer, viewer).run(lo);
     std::printf("%s", stats.summary().c_str());
     if (!controller) current = renderer.options();  // a controller's are its own: the panel's stay as asked

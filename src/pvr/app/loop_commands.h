@@ -37,17 +37,27 @@ struct LoopCommandArgs {
   bool noPanel = false;
   std::string sceneName;         ///< as given, for the settings file
   std::string acuity = "linear";
-  double budgetMs = 0;            ///< > 0: the budget controller runs the loop's options
+  std::string budget;             ///< --budget-ms: milliseconds or "display"; empty: no controller
   std::string controllerProfile;  ///< empty: ControlProfile::generic
 };
 
 // Writes `j` (indented) to `path`, making its folder; throws pvr::Error if it cannot.
 void writeJson(const std::string& path, const nlohmann::json& j);
 
-// --budget-ms: the controller for a scene's effect groups, from the options the user asked for and
-// the final rig; its foveation knob uses the options' mask, or one made for the rig into `mask`.
-// Null for budgetMs <= 0. Throws pvr::Error for a bad profile or budget.
-std::unique_ptr<BudgetController> makeBudgetController(double budgetMs, const std::string& profilePath, const Scene& scene,
+// --budget-ms: a number of milliseconds, or "display" for the display's frame period (the OpenXR
+// runtime's predicted period, the monitor's refresh, xr --offscreen's slot), followed as it changes.
+struct BudgetSpec {
+  double ms = 0;                ///< 0: no controller
+  bool followsDisplay = false;  ///< ms is then 1000/90 until the presenter reports its period
+  bool enabled() const { return ms > 0; }
+};
+// Empty: no controller. Throws pvr::Error (one line) for anything else that is not a budget.
+BudgetSpec parseBudget(const std::string& text);
+
+// The controller for a scene's effect groups, from the options the user asked for and the final
+// rig; its foveation knob uses the options' mask, or one made for the rig into `mask`. Null when
+// the budget is not enabled. Throws pvr::Error for a bad profile.
+std::unique_ptr<BudgetController> makeBudgetController(const BudgetSpec& budget, const std::string& profilePath, const Scene& scene,
                                                        const RenderOptions& options, const StereoRig& rig,
                                                        const std::string& acuity, std::optional<FoveationMask>& mask);
 

@@ -327,6 +327,10 @@ std::vector<ControlSetting> BudgetController::raisesOf(const ControlSetting& s) 
   return out;
 }
 
+void BudgetController::setBudget(double budgetMs) {
+  if (budgetMs > 0.0 && finite(budgetMs) && budgetMs <= 10000.0) params_.budgetMs = budgetMs;
+}
+
 ControlDecision BudgetController::decide(double nowMs) {
   ControlDecision d;
   if (!started_) {
@@ -429,6 +433,7 @@ ControlDecision BudgetController::decide(double nowMs) {
     }
   }
   d.setting = current_;
+  d.budgetMs = params_.budgetMs;
   d.predictedMs = predictMs(current_);
   d.predictedError = predictError(current_);
   lastPredictedMs_ = d.predictedMs;
@@ -483,6 +488,16 @@ size_t ControlLog::framesOver(double budgetMs) const {
   return size_t(std::count_if(entries_.begin(), entries_.end(), [&](const ControlLogEntry& e) { return e.frameMs > budgetMs; }));
 }
 
+size_t ControlLog::framesOverTheirBudget() const {
+  return size_t(std::count_if(entries_.begin(), entries_.end(),
+                              [](const ControlLogEntry& e) { return e.frameMs > e.decision.budgetMs; }));
+}
+
+bool ControlLog::budgetChanged() const {
+  return std::any_of(entries_.begin(), entries_.end(),
+                     [&](const ControlLogEntry& e) { return e.decision.budgetMs != entries_.front().decision.budgetMs; });
+}
+
 size_t ControlLog::changes() const {
   return size_t(std::count_if(entries_.begin(), entries_.end(), [](const ControlLogEntry& e) {
     const std::string c = e.decision.change;
@@ -504,6 +519,7 @@ nlohmann::json ControlLog::toJson(const BudgetController& controller) const {
                         {"costs_ms", {{"photons", e.costs.photonMs}, {"density", e.costs.densityMs}, {"eye_rays", e.costs.rayMs},
                                       {"denoise", e.costs.denoiseMs}, {"rest", e.costs.restMs}}}};
     if (e.measuredError >= 0) f["measured_error"] = e.measuredError;
+    if (budgetChanged()) f["budget_ms"] = e.decision.budgetMs;
     frames.push_back(std::move(f));
   }
   return {{"budget_ms", budget},
@@ -511,7 +527,7 @@ nlohmann::json ControlLog::toJson(const BudgetController& controller) const {
           {"margin_at_end", controller.currentMargin()},
           {"profile", controller.profile().scene},
           {"frame_ms", latencyStats(std::move(ms))},
-          {"frames_over_budget", framesOver(budget)},
+          {"frames_over_budget", framesOverTheirBudget()},
           {"changes", changes()},
           {"frames", std::move(frames)}};
 }
@@ -525,7 +541,7 @@ std::string ControlLog::summary(const BudgetController& controller) const {
   std::snprintf(line, sizeof line,
                 "  controller: budget %.2f ms, frame p50 %.3f p99 %.3f ms, %zu of %zu frames over, %zu changes, "
                 "predicted relMSE mean %.4f\n",
-                budget, t.p50, t.p99, framesOver(budget), entries_.size(), changes(), e.mean);
+                budget, t.p50, t.p99, framesOverTheirBudget(), entries_.size(), changes(), e.mean);
   return line;
 }
 

@@ -98,6 +98,7 @@ struct BudgetControllerParams {
 struct ControlDecision {
   ControlSetting setting;
   double predictedMs = 0, predictedError = 0;
+  double budgetMs = 0;  ///< the budget this decision kept to
   const char* change = "hold";  ///< "hold" | "lower" | "raise" | "replan" (over the limit, to a better setting that fits) | "start"
 };
 
@@ -121,6 +122,9 @@ class BudgetController {
 
   // Before a frame at time `nowMs` (any monotonic clock): the setting to render with.
   ControlDecision decide(double nowMs);
+  // A new budget (the display's period changed): decisions from the next one on keep to it.
+  // Periods outside (0, 10000] ms are ignored: a runtime may report 0 before it knows.
+  void setBudget(double budgetMs);
   // New options from the user (the viewer's panel): what the knobs apply to from now on.
   void setBase(const RenderOptions& base) { base_ = base; }
   // The options of a setting (base with the setting's knobs applied).
@@ -176,6 +180,9 @@ class ControlLog {
   std::vector<ControlLogEntry>& entries() { return entries_; }
   const std::vector<ControlLogEntry>& entries() const { return entries_; }
   size_t framesOver(double budgetMs) const;
+  // Frames over the budget in force when each was decided (the display's period may change).
+  size_t framesOverTheirBudget() const;
+  bool budgetChanged() const;  ///< not every frame kept to the same budget
   size_t changes() const;  ///< frames whose decision changed the setting
   nlohmann::json toJson(const BudgetController& controller) const;
   std::string summary(const BudgetController& controller) const;  ///< one line

@@ -37,6 +37,7 @@ bool OffscreenPresenter::waitFrame(FrameRequest& request) {
   }
   request.shouldRender = true;
   request.deadline = slot + period_;
+  request.displayPeriodMs = std::chrono::duration<double, std::milli>(period_).count();
   ++frame_;
   return true;
 }

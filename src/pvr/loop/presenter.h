@@ -20,6 +20,9 @@ struct FrameRequest {
   bool gazeTracked = false;    ///< the gaze came from an eye tracker this frame
   bool shouldRender = true;    ///< false: the display shows nothing of it (hand back an empty frame)
   std::optional<LoopClock::time_point> deadline;  ///< the hand-over must be done by then
+  // The display's frame period (OpenXR's predicted display period, the monitor's refresh, the
+  // offscreen slot), when the presenter knows it: `--budget-ms display` follows it.
+  std::optional<double> displayPeriodMs;
 };
 
 // A rendered frame as handed to the presenter.

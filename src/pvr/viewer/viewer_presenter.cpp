@@ -256,6 +256,7 @@ struct ViewerPresenter::Impl {
       const char* estimators[] = {"radius", "knn"};
       ImGui::Combo("estimator", &settings.estimator, estimators, 2);
       if (settings.estimator == 1) ImGui::SliderInt("k", &settings.k, 1, 64);
+      ImGui::Checkbox("clip the disc at walls and edges", &settings.clippedBoundary);
       ImGui::Combo("GPU kernel", &settings.kernel, kKernels, 4);
       ImGui::Combo("stereo", &settings.stereo, kStereo, 3);
       ImGui::Checkbox("foveated", &settings.foveated);
@@ -446,6 +447,11 @@ bool ViewerPresenter::waitFrame(FrameRequest& request) {
     if (k.frame == m.frame) m.pressKey(k.key);
   if (m.stop || glfwWindowShouldClose(m.window)) return false;
   if (m.backendChange) return false;
+  // The monitor the window is on is not tracked: the primary one's refresh is the display period.
+  if (GLFWmonitor* monitor = glfwGetPrimaryMonitor()) {
+    const GLFWvidmode* mode = glfwGetVideoMode(monitor);
+    if (mode && mode->refreshRate > 0) request.displayPeriodMs = 1000.0 / double(mode->refreshRate);
+  }
   auto now = std::chrono::steady_clock::now();
   float dt = std::min(std::chrono::duration<float>(now - m.lastFrame).count(), 0.1f);
   m.lastFrame = now;
@@ -504,6 +510,7 @@ void ViewerPresenter::adjustOptions(RenderOptions& o) {
   if (s.map != a.map) o.map = s.map ? PhotonMapKind::KdTree : PhotonMapKind::HashGrid;
   if (s.estimator != a.estimator) o.gather.density.estimator = s.estimator ? Estimator::Knn : Estimator::Radius;
   if (s.k != a.k) o.gather.density.k = s.k;
+  if (s.clippedBoundary != a.clippedBoundary) o.gather.density.boundary = s.clippedBoundary ? Boundary::Clipped : Boundary::Sphere;
   const DensityKernel kernels[] = {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory, DensityKernel::CellSorted};
   if (s.kernel != a.kernel) o.kernel = kernels[std::clamp(s.kernel, 0, 3)];
   const StereoMode modes[] = {StereoMode::Separate, StereoMode::Scatter, StereoMode::Gather};

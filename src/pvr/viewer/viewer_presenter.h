@@ -20,6 +20,7 @@ struct ViewerSettings {
   int map = 0;                     ///< 0 hashgrid, 1 kdtree
   int estimator = 0;               ///< 0 radius, 1 knn
   int k = 32;
+  bool clippedBoundary = false;    ///< --boundary clipped: the estimate's disc clipped at walls and edges
   int kernel = 1;                  ///< single, hybrid, shared, sorted
   int stereo = 0;                  ///< separate, scatter, gather
   bool foveated = false;

@@ -508,6 +508,7 @@ bool XrPresenter::waitFrame(FrameRequest& request) {
     }
   }
   request.deadline = m.toSteady(m.frameState.predictedDisplayTime);
+  if (m.frameState.predictedDisplayPeriod > 0) request.displayPeriodMs = double(m.frameState.predictedDisplayPeriod) * 1e-6;
   return true;
 }
 
