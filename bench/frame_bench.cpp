@@ -666,7 +666,8 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
               "after its own warm-up run): Mrays/s at the median run time / at the p99 run time (p99 by nearest "
               "rank: the slowest under 100 runs). Two BVH layouts, both built by Embree (SAH + spatial splits), "
               "both with the same watertight triangle test: binary (64-byte nodes, 4 triangles a leaf) and "
-              "8-wide with 8-bit quantized child boxes (80-byte nodes, 3 triangles a leaf; the renderer's)\n\n"
+              "8-wide with 8-bit quantized child boxes (80-byte nodes, 3 triangles a leaf; the renderer's); the "
+              "traversal stack in shared memory (the renderer's) or in local memory\n\n"
               "| scene | triangles | BVH | nodes | refs | MiB | build ms | SAH cost | eye size | primary Mrays/s "
               "(median / p99) | shadow Mrays/s (median / p99) | diffuse Mrays/s (median / p99) | check vs Embree |\n"
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -678,14 +679,14 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
     CpuBackend cpu(scene);
     const Bvh binary = Bvh::build(scene);
     const WideBvh wide = WideBvh::build(scene);
-    for (int layout = 0; layout < 2; ++layout) {
-      const bool isWide = layout == 0;
+    for (int variant = 0; variant < 4; ++variant) {
+      const bool isWide = variant < 2, sharedStack = variant % 2 == 0;
       GpuRayBench bench = isWide ? GpuRayBench(gpu, wide) : GpuRayBench(gpu, binary);
       // One run per call, so that every run's time is kept (measure reports the median of its runs).
       GpuRayThroughput t;
       std::vector<double> primaryMs, shadowMs, diffuseMs;
       for (int r = 0; r < repeats; ++r) {
-        t = bench.measure(rig, 1);
+        t = bench.measure(rig, 1, sharedStack);
         primaryMs.push_back(t.primaryMs), shadowMs.push_back(t.shadowMs), diffuseMs.push_back(t.diffuseMs);
       }
       const LatencyStats primary = latencyStats(primaryMs), shadow = latencyStats(shadowMs),
@@ -706,17 +707,18 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
       failures += ok ? 0 : 1;
       const BvhBuildStats& s = isWide ? wide.stats() : binary.stats();
       const double mib = double(isWide ? wide.memoryBytes() : binary.memoryBytes()) / (1024.0 * 1024.0);
-      const char* layoutName = isWide ? "8-wide, quantized" : "binary";
+      const std::string layoutName = std::string(isWide ? "8-wide, quantized" : "binary") +
+                                     (sharedStack ? "" : ", local-memory stack");
       auto mrays = [](uint64_t rays, double ms) { return ms > 0 ? double(rays) / (ms * 1e3) : 0.0; };
       std::printf("| %s | %u | %s | %u | %u | %.1f | %.0f | %.1f | %dx%d x2 | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f "
                   "| %s (%.4f%% agree) |\n",
-                  name.c_str(), s.inputTriangles, layoutName, s.nodes, s.triangleReferences, mib, s.buildMs, s.sahCost,
+                  name.c_str(), s.inputTriangles, layoutName.c_str(), s.nodes, s.triangleReferences, mib, s.buildMs, s.sahCost,
                   rig.width, rig.height, mrays(t.primaryRays, primary.p50), mrays(t.primaryRays, primary.p99),
                   mrays(t.shadowRays, shadow.p50), mrays(t.shadowRays, shadow.p99), mrays(t.diffuseRays, diffuse.p50),
                   mrays(t.diffuseRays, diffuse.p99), ok ? "ok" : "MISMATCH", 100.0 * agreement);
       // *_ms stay the medians (now the nearest-rank p50) and *_mrays_s their throughputs; the objects
       // "primary", "shadow" and "diffuse" hold the run times' mean, p50, p99 and max in ms.
-      json.push_back({{"suite", "rays"}, {"scene", name}, {"bvh", isWide ? "wide8" : "binary"},
+      json.push_back({{"suite", "rays"}, {"scene", name}, {"bvh", isWide ? "wide8" : "binary"}, {"stack", sharedStack ? "shared" : "local"},
                       {"triangles", s.inputTriangles}, {"bvh_nodes", s.nodes}, {"bvh_refs", s.triangleReferences},
                       {"bvh_mib", mib}, {"bvh_build_ms", s.buildMs}, {"sah_cost", s.sahCost},
                       {"bvh_depth", s.maxDepth}, {"width", rig.width}, {"height", rig.height},

@@ -9,10 +9,17 @@ namespace pvr {
 using namespace cuda;
 namespace {
 
+// The traversal stack in shared memory (the renderer's choice) or in local memory (for comparison).
+template <bool SharedStack, class Intersector>
+__device__ inline Intersector stackFor(const Intersector& in) {
+  if constexpr (SharedStack) return withSharedStack<kTile * kTile>(in);
+  else return in;
+}
+
 // Ray-throughput kernels: one ray per pixel (centre), or one per primary hit.
-template <class Intersector>
+template <class Intersector, bool SharedStack>
 __global__ void primaryRaysKernel(Intersector sceneIntersector, EyeCamera camera, Hit* hits) {
-  const Intersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const Intersector intersector = stackFor<SharedStack>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   Hit hit;
@@ -30,10 +37,10 @@ __device__ inline bool primaryPoint(const SceneView& scene, const EyeCamera& cam
   return true;
 }
 
-template <class Intersector>
+template <class Intersector, bool SharedStack>
 __global__ void shadowRaysKernel(SceneView scene, Intersector sceneIntersector, EyeCamera camera, const Hit* hits,
                                  uint8_t* occluded) {
-  const Intersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const Intersector intersector = stackFor<SharedStack>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   SurfacePoint sp;
@@ -48,10 +55,10 @@ __global__ void shadowRaysKernel(SceneView scene, Intersector sceneIntersector, 
   occluded[pixel] = intersector.occluded({origin, d / dist}, dist * (1.0f - 1e-3f)) ? 1 : 0;
 }
 
-template <class Intersector>
+template <class Intersector, bool SharedStack>
 __global__ void diffuseRaysKernel(SceneView scene, Intersector sceneIntersector, EyeCamera camera, const Hit* hits,
                                   Hit* out) {
-  const Intersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const Intersector intersector = stackFor<SharedStack>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   SurfacePoint sp;
@@ -76,7 +83,7 @@ double median(std::vector<double> v) {
 
 
 
-template <class Intersector>
+template <class Intersector, bool SharedStack>
 GpuRayThroughput measureRays(CudaFrameBackend& backend, const Intersector& sceneIntersector, const StereoRig& rig,
                              int repeats) {
   const DeviceScene& scene = backend.deviceScene();
@@ -96,16 +103,16 @@ GpuRayThroughput measureRays(CudaFrameBackend& backend, const Intersector& scene
     for (int e = 0; e < 2; ++e) {
       EyeCamera camera = rig.eye(Eye(e));
       timer.start(stream);
-      launch("primary rays", primaryRaysKernel<Intersector>, grid, block, 0, stream, sceneIntersector, camera, primary[e].data());
+      launch("primary rays", primaryRaysKernel<Intersector, SharedStack>, grid, block, 0, stream, sceneIntersector, camera, primary[e].data());
       timer.stop(stream);
       primaryMs += timer.ms();
       timer.start(stream);
-      launch("shadow rays", shadowRaysKernel<Intersector>, grid, block, 0, stream, scene.view, sceneIntersector, camera,
+      launch("shadow rays", shadowRaysKernel<Intersector, SharedStack>, grid, block, 0, stream, scene.view, sceneIntersector, camera,
              primary[e].data(), occluded.data());
       timer.stop(stream);
       shadowMs += timer.ms();
       timer.start(stream);
-      launch("diffuse rays", diffuseRaysKernel<Intersector>, grid, block, 0, stream, scene.view, sceneIntersector, camera,
+      launch("diffuse rays", diffuseRaysKernel<Intersector, SharedStack>, grid, block, 0, stream, scene.view, sceneIntersector, camera,
              primary[e].data(), secondary.data());
       timer.stop(stream);
       diffuseMs += timer.ms();
@@ -161,10 +168,14 @@ GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const WideBvh& bvh) : impl_(
 
 GpuRayBench::~GpuRayBench() = default;
 
-GpuRayThroughput GpuRayBench::measure(const StereoRig& rig, int repeats) {
+GpuRayThroughput GpuRayBench::measure(const StereoRig& rig, int repeats, bool sharedStack) {
   PVR_CUDA_CHECK(cudaDeviceSynchronize());
-  return impl_->isWide ? measureRays(impl_->backend, impl_->wide, rig, repeats)
-                       : measureRays(impl_->backend, impl_->binary, rig, repeats);
+  Impl& m = *impl_;
+  if (m.isWide)
+    return sharedStack ? measureRays<WideBvhIntersector, true>(m.backend, m.wide, rig, repeats)
+                       : measureRays<WideBvhIntersector, false>(m.backend, m.wide, rig, repeats);
+  return sharedStack ? measureRays<BvhIntersector, true>(m.backend, m.binary, rig, repeats)
+                     : measureRays<BvhIntersector, false>(m.backend, m.binary, rig, repeats);
 }
 
 }  // namespace pvr

@@ -26,7 +26,9 @@ class GpuRayBench {
   ~GpuRayBench();
   GpuRayBench(const GpuRayBench&) = delete;
   GpuRayBench& operator=(const GpuRayBench&) = delete;
-  GpuRayThroughput measure(const StereoRig& rig, int repeats);
+  // sharedStack: the traversal stack in shared memory, as the renderer's kernels keep it; false:
+  // in local memory (for comparison).
+  GpuRayThroughput measure(const StereoRig& rig, int repeats, bool sharedStack = true);
 
  private:
   struct Impl;
