@@ -41,6 +41,16 @@ struct BuildInput {
 
 constexpr unsigned kMaxLeafSize = 4;
 
+// A leaf's copy of input triangle `prim`, vertices inline.
+BvhTriangle leafTriangle(const BuildInput& in, uint32_t prim) {
+  BvhTriangle t{};
+  t.v0 = (*in.vertices)[(*in.indices)[3 * size_t(prim)]];
+  t.v1 = (*in.vertices)[(*in.indices)[3 * size_t(prim) + 1]];
+  t.v2 = (*in.vertices)[(*in.indices)[3 * size_t(prim) + 2]];
+  t.primId = prim;
+  return t;
+}
+
 void* createInner(RTCThreadLocalAllocator alloc, unsigned int childCount, void*) {
   auto* node = static_cast<BuildInner*>(rtcThreadLocalAlloc(alloc, sizeof(BuildInner), 16));
   node->leaf = false;
@@ -149,7 +159,7 @@ class Flattener {
       const auto* leaf = static_cast<const BuildLeaf*>(child);
       nodes_[index].child[c] = ~int32_t(tris_.size());
       nodes_[index].count[c] = leaf->count;
-      for (uint32_t i = 0; i < leaf->count; ++i) tris_.push_back(triangle(leaf->prims[i]));
+      for (uint32_t i = 0; i < leaf->count; ++i) tris_.push_back(leafTriangle(in_, leaf->prims[i]));
       stats_.leaves++;
       stats_.sahCost += relArea * leaf->count;
       stats_.maxDepth = std::max(stats_.maxDepth, depth);
@@ -170,15 +180,6 @@ class Flattener {
     }
     nodes_[index].child[c] = ~0;
     nodes_[index].count[c] = 0;
-  }
-
-  BvhTriangle triangle(uint32_t prim) const {
-    BvhTriangle t{};
-    t.v0 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim)]];
-    t.v1 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 1]];
-    t.v2 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 2]];
-    t.primId = prim;
-    return t;
   }
 
   const BuildInput& in_;
@@ -325,7 +326,7 @@ class WideBvhFlattener {
         if (leaf->count == 0 || leaf->count > kWideBvhMaxLeafSize || offset + leaf->count > 24)
           throw Error("wide BVH: a leaf of " + std::to_string(leaf->count) + " triangles cannot be encoded");
         node.leaf[s] = uint8_t((leaf->count << 5) | offset);
-        for (uint32_t i = 0; i < leaf->count; ++i) triangles_.push_back(triangle(leaf->prims[i]));
+        for (uint32_t i = 0; i < leaf->count; ++i) triangles_.push_back(leafTriangle(in_, leaf->prims[i]));
         stats.leaves++;
         stats.sahCost += relArea * leaf->count;
       } else {
@@ -393,15 +394,6 @@ class WideBvhFlattener {
       node.lower[a][s] = uint8_t(qlo);
       node.upper[a][s] = uint8_t(qhi);
     }
-  }
-
-  BvhTriangle triangle(uint32_t prim) const {
-    BvhTriangle t{};
-    t.v0 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim)]];
-    t.v1 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 1]];
-    t.v2 = (*in_.vertices)[(*in_.indices)[3 * size_t(prim) + 2]];
-    t.primId = prim;
-    return t;
   }
 
   const BuildInput& in_;
