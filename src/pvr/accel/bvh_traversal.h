@@ -68,6 +68,18 @@ PVR_HOST_DEVICE inline bool intersectTriangleWatertight(const WatertightRay& r, 
   return true;
 }
 
+// A leaf triangle's vertices and scene index (three 16-byte loads through the read-only cache).
+PVR_HOST_DEVICE inline void loadBvhTriangle(const BvhTriangle* tri, Vec3& v0, Vec3& v1, Vec3& v2, uint32_t& prim) {
+#ifdef __CUDA_ARCH__
+  const float4* p = reinterpret_cast<const float4*>(tri);
+  float4 a = __ldg(p), b = __ldg(p + 1), c = __ldg(p + 2);
+  v0 = {a.x, a.y, a.z}, v1 = {b.x, b.y, b.z}, v2 = {c.x, c.y, c.z};
+  prim = __float_as_uint(a.w);
+#else
+  v0 = tri->v0, v1 = tri->v1, v2 = tri->v2, prim = tri->primId;
+#endif
+}
+
 struct BvhIntersector {
   BvhView bvh;
   // Alpha masking (any-hit): with alphaTest, hits on texels a material cuts out are skipped.
@@ -103,17 +115,6 @@ struct BvhIntersector {
 #else
     for (int i = 0; i < 12; ++i) b[i] = node->bounds[i];
     child[0] = node->child[0], child[1] = node->child[1], count[0] = node->count[0], count[1] = node->count[1];
-#endif
-  }
-
-  PVR_HOST_DEVICE static void loadTriangle(const BvhTriangle* tri, Vec3& v0, Vec3& v1, Vec3& v2, uint32_t& prim) {
-#ifdef __CUDA_ARCH__
-    const float4* p = reinterpret_cast<const float4*>(tri);
-    float4 a = __ldg(p), b = __ldg(p + 1), c = __ldg(p + 2);
-    v0 = {a.x, a.y, a.z}, v1 = {b.x, b.y, b.z}, v2 = {c.x, c.y, c.z};
-    prim = __float_as_uint(a.w);
-#else
-    v0 = tri->v0, v1 = tri->v1, v2 = tri->v2, prim = tri->primId;
 #endif
   }
 
@@ -162,7 +163,7 @@ struct BvhIntersector {
           for (uint32_t i = 0; i < count[c]; ++i) {
             Vec3 v0, v1, v2;
             uint32_t prim;
-            loadTriangle(tri + i, v0, v1, v2, prim);
+            loadBvhTriangle(tri + i, v0, v1, v2, prim);
             float t, u, v;
             if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
               if (alphaTest && !alphaScene.alphaPasses(prim, u, v)) continue;

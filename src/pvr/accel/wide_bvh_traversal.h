@@ -78,17 +78,6 @@ struct WideBvhIntersector {
 
   PVR_HOST_DEVICE static uint32_t byteAt(const uint32_t* w, int k) { return (w[k >> 2] >> (8 * (k & 3))) & 0xffu; }
 
-  PVR_HOST_DEVICE static void loadTriangle(const BvhTriangle* tri, Vec3& v0, Vec3& v1, Vec3& v2, uint32_t& prim) {
-#ifdef __CUDA_ARCH__
-    const float4* p = reinterpret_cast<const float4*>(tri);
-    float4 a = __ldg(p), b = __ldg(p + 1), c = __ldg(p + 2);
-    v0 = {a.x, a.y, a.z}, v1 = {b.x, b.y, b.z}, v2 = {c.x, c.y, c.z};
-    prim = __float_as_uint(a.w);
-#else
-    v0 = tri->v0, v1 = tri->v1, v2 = tri->v2, prim = tri->primId;
-#endif
-  }
-
   PVR_HOST_DEVICE static int highestBit(uint32_t x) {
 #ifdef __CUDA_ARCH__
     return 31 - __clz(x);
@@ -194,7 +183,7 @@ struct WideBvhIntersector {
         triangleBits &= triangleBits - 1u;
         Vec3 v0, v1, v2;
         uint32_t prim;
-        loadTriangle(bvh.triangles + triangleBase + uint32_t(b), v0, v1, v2, prim);
+        loadBvhTriangle(bvh.triangles + triangleBase + uint32_t(b), v0, v1, v2, prim);
         float t, u, v;
         if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
           if (alphaTest && !alphaScene.alphaPasses(prim, u, v)) continue;
