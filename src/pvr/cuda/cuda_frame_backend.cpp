@@ -36,7 +36,7 @@ bool cudaDeviceUsable(std::string* why) {
 
 struct CudaFrameBackend::Impl {
   const Scene& scene;
-  WideBvh bvh;
+  Bvh bvh;
   cudaStream_t stream = nullptr;
   cudaDeviceProp properties{};
   cuda::DeviceScene deviceScene;
@@ -80,7 +80,7 @@ struct CudaFrameBackend::Impl {
   cuda::DeviceBuffer<uint32_t> maskTriangles, maskTrianglesBySize;
   uint32_t smallTriangles = 0;
 
-  explicit Impl(const Scene& s) : scene(s), bvh(WideBvh::build(s)) {
+  explicit Impl(const Scene& s) : scene(s), bvh(Bvh::build(s)) {
     PVR_CUDA_CHECK(cudaGetDeviceProperties(&properties, 0));
     PVR_CUDA_CHECK(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking));
     clock = std::make_unique<cuda::CudaStageClock>(stream);

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "pvr/accel/wide_bvh.h"
+#include "pvr/accel/bvh.h"
 #include "pvr/pipeline/frame_renderer.h"
 #include "pvr/photon/photon.h"
 

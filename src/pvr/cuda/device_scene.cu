@@ -5,7 +5,7 @@
 
 namespace pvr::cuda {
 
-void DeviceScene::upload(const Scene& scene, const WideBvh& bvh) {
+void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   SceneView host = scene.view();
   size_t vertexCount = scene.vertices().size();
   vertices.upload(scene.vertices().data(), vertexCount, "scene vertices");

@@ -1,6 +1,6 @@
 #pragma once
 // The scene and its BVH on the GPU, for the shared algorithm code's device side.
-#include "pvr/accel/wide_bvh_traversal.h"
+#include "pvr/accel/bvh_traversal.h"
 #include "pvr/cuda/cuda_util.cuh"
 #include "pvr/photon/hash_grid.h"
 #include "pvr/photon/kd_tree.h"
@@ -9,8 +9,10 @@
 
 namespace pvr::cuda {
 
-// The renderer's ray queries: the 8-wide quantized BVH (wide_bvh.h).
-using SceneIntersector = WideBvhIntersector;
+// The renderer's ray queries: the binary BVH. The 8-wide quantized BVH (wide_bvh.h) traces 2-3x
+// faster in standalone ray kernels (bench --suite rays) but made the eye kernels slower on the
+// H200, inlined or not (docs/benchmarks.md, 2026-12-05), so it is not used here yet.
+using SceneIntersector = BvhIntersector;
 
 struct DeviceScene {
   DeviceBuffer<Vec3> vertices, normals, faceNormals;
@@ -21,12 +23,12 @@ struct DeviceScene {
   DeviceBuffer<Material> materials;
   DeviceBuffer<PunctualLight> punctualLights;
   DeviceBuffer<float> lightCdf;
-  DeviceBuffer<WideBvhNode> nodes;
+  DeviceBuffer<BvhNode> nodes;
   DeviceBuffer<BvhTriangle> triangles;
   SceneView view;
   SceneIntersector intersector;
 
-  void upload(const Scene& scene, const WideBvh& bvh);
+  void upload(const Scene& scene, const Bvh& bvh);
 };
 
 }  // namespace pvr::cuda
