@@ -123,6 +123,7 @@ std::unique_ptr<BudgetController> makeBudgetController(const BudgetSpec& budget,
   }
   BudgetControllerParams params;
   params.budgetMs = budget.ms;
+  params.followsDisplay = budget.followsDisplay;
   params.foveationAvailable = fovea != nullptr;
   return std::make_unique<BudgetController>(profile, params, options, fovea);
 }
@@ -215,7 +216,6 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::unique_ptr<BudgetController> controller = makeBudgetController(
         parseBudget(args.budget), args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
-    lo.budgetFollowsDisplay = parseBudget(args.budget).followsDisplay;
     stats = runLoop(presenter);
     auto skipWarmup = [&](std::vector<double> v) {
       if (v.size() > args.warmup) v.erase(v.begin(), v.begin() + long(args.warmup));
@@ -263,7 +263,6 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::unique_ptr<BudgetController> controller = makeBudgetController(
         parseBudget(args.budget), args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
-    lo.budgetFollowsDisplay = parseBudget(args.budget).followsDisplay;
     stats = runLoop(presenter);
     run["presenter"] = "openxr";
     run["runtime"] = info.runtime;
@@ -367,7 +366,6 @@ int runViewCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::unique_ptr<BudgetController> controller = makeBudgetController(
         parseBudget(args.budget), args.controllerProfile, *setup.scene, current, renderer.rig(), args.acuity, controlMask);
     lo.controller = controller.get();
-    lo.budgetFollowsDisplay = parseBudget(args.budget).followsDisplay;
     FrameStats stats = FrameLoop(renderer, viewer).run(lo);
     std::printf("%s", stats.summary().c_str());
     if (!controller) current = renderer.options();  // a controller's are its own: the panel's stay as asked

@@ -509,6 +509,7 @@ nlohmann::json ControlLog::toJson(const BudgetController& controller) const {
   const double budget = controller.params().budgetMs;
   std::vector<double> ms;
   nlohmann::json frames = nlohmann::json::array();
+  const bool perFrameBudget = budgetChanged();
   for (const ControlLogEntry& e : entries_) {
     ms.push_back(e.frameMs);
     nlohmann::json f = {{"ms", e.frameMs},
@@ -519,7 +520,7 @@ nlohmann::json ControlLog::toJson(const BudgetController& controller) const {
                         {"costs_ms", {{"photons", e.costs.photonMs}, {"density", e.costs.densityMs}, {"eye_rays", e.costs.rayMs},
                                       {"denoise", e.costs.denoiseMs}, {"rest", e.costs.restMs}}}};
     if (e.measuredError >= 0) f["measured_error"] = e.measuredError;
-    if (budgetChanged()) f["budget_ms"] = e.decision.budgetMs;
+    if (perFrameBudget) f["budget_ms"] = e.decision.budgetMs;
     frames.push_back(std::move(f));
   }
   return {{"budget_ms", budget},

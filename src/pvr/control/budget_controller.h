@@ -82,6 +82,9 @@ struct ControlProfile {
 
 struct BudgetControllerParams {
   double budgetMs = 1000.0 / 90.0;
+  // The frame loop sets the budget to the display's frame period (FrameRequest::displayPeriodMs)
+  // whenever the presenter reports one (`--budget-ms display`).
+  bool followsDisplay = false;
   // The predicted time must stay under budget x (1 - margin). The margin follows how far the
   // frames of the last second ran over their predictions (+ 2 %), within [margin, maxMargin];
   // startMargin until a second has been seen.

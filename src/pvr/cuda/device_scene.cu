@@ -32,7 +32,7 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
     offset += level.size();
   }
   if (!deviceTextures.empty()) textures.upload(deviceTextures.data(), deviceTextures.size(), "texture views");
-  if (!bvh.nodes().empty()) nodes.upload(bvh.nodes().data(), bvh.nodes().size(), "BVH nodes");
+  nodes.upload(bvh.nodes().data(), bvh.nodes().size(), "BVH nodes");
   triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
   PVR_CUDA_CHECK(cudaDeviceSynchronize());
   view = host;

@@ -32,7 +32,7 @@ FrameStats FrameLoop::run(const FrameLoopOptions& options) {
     LoopClock::time_point start = LoopClock::now();
     std::optional<ControlDecision> decision;
     if (controller) {
-      if (options.budgetFollowsDisplay && request.displayPeriodMs) controller->setBudget(*request.displayPeriodMs);
+      if (controller->params().followsDisplay && request.displayPeriodMs) controller->setBudget(*request.displayPeriodMs);
       presenter_.adjustOptions(asked);
       controller->setBase(asked);
       decision = controller->decide(msBetween(loopStart, start));

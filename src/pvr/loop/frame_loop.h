@@ -18,9 +18,6 @@ struct FrameLoopOptions {
   // budget (the frame's work, FrameRecord::cpuMs); its decisions go into the stats. Null: the
   // renderer's options as they are (and as the presenter adjusts them).
   BudgetController* controller = nullptr;
-  // The controller's budget is the display's frame period (FrameRequest::displayPeriodMs) while
-  // the presenter reports one (`--budget-ms display`).
-  bool budgetFollowsDisplay = false;
 };
 
 class FrameLoop {
