@@ -152,8 +152,7 @@ GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const Bvh& bvh) : impl_(std:
   impl_->triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
   impl_->binary.bvh = {impl_->binaryNodes.data(), impl_->triangles.data(), uint32_t(bvh.nodes().size()),
                        uint32_t(bvh.triangles().size())};
-  impl_->binary.alphaTest = backend.deviceScene().intersector.alphaTest;
-  impl_->binary.alphaScene = backend.deviceScene().view;
+  impl_->binary.alphaScene = backend.deviceScene().intersector.alphaScene;
 }
 
 GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const WideBvh& bvh) : impl_(std::make_unique<Impl>(backend)) {
@@ -162,8 +161,7 @@ GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const WideBvh& bvh) : impl_(
   impl_->triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
   impl_->wide.bvh = {impl_->wideNodes.data(), impl_->triangles.data(), uint32_t(bvh.nodes().size()),
                      uint32_t(bvh.triangles().size())};
-  impl_->wide.alphaTest = backend.deviceScene().intersector.alphaTest;
-  impl_->wide.alphaScene = backend.deviceScene().view;
+  impl_->wide.alphaScene = backend.deviceScene().intersector.alphaScene;
 }
 
 GpuRayBench::~GpuRayBench() = default;

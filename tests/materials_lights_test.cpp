@@ -127,8 +127,8 @@ TEST(Alpha, CutOutTexelsCastNoShadowOnBothIntersectors) {
   EmbreeIntersector embree(scene);
   Bvh bvh = Bvh::build(scene);
   BvhIntersector ours{bvh.view()};
-  ours.alphaTest = true;
-  ours.alphaScene = scene.view();
+  const SceneView view = scene.view();
+  ours.alphaScene = &view;
   int blocked = 0;
   for (int i = 0; i < 40; ++i)
     for (int j = 0; j < 40; ++j) {

@@ -80,11 +80,23 @@ PVR_HOST_DEVICE inline void loadBvhTriangle(const BvhTriangle* tri, Vec3& v0, Ve
 #endif
 }
 
+// Alpha masking (any-hit) of a candidate hit: false where the triangle's material cuts the texel
+// out. The material check is inline; the texture lookup is out of line, so that the traversal
+// loops do not carry a copy of the texture sampler in their registers and instruction cache.
+struct AlphaMask {
+  PVR_HOST_DEVICE static bool passes(const SceneView* scene, uint32_t prim, float u, float v) {
+    return scene == nullptr || !scene->material(prim).alphaTested() || texelPasses(*scene, prim, u, v);
+  }
+  PVR_HOST_DEVICE PVR_NOINLINE static bool texelPasses(const SceneView& scene, uint32_t prim, float u, float v) {
+    return scene.alphaPasses(prim, u, v);
+  }
+};
+
 struct BvhIntersector {
   BvhView bvh;
-  // Alpha masking (any-hit): with alphaTest, hits on texels a material cuts out are skipped.
-  bool alphaTest = false;
-  SceneView alphaScene;
+  // Alpha masking (any-hit): non-null, hits on texels its materials cut out are skipped. A pointer
+  // (on the GPU, to a copy of the view in device memory) keeps the intersector a few registers.
+  const SceneView* alphaScene = nullptr;
   // Where this thread keeps its traversal stack: entry i at sharedStack[i * sharedStride], a
   // column of its block's shared memory (cuda::withSharedStack); null: an array in local memory.
   // On the GPU local memory is written through to L2: a ray kernel with local stacks spent 82 %
@@ -104,18 +116,29 @@ struct BvhIntersector {
   }
 
  private:
-  PVR_HOST_DEVICE static void loadNode(const BvhNode* node, float* b, int32_t* child, uint32_t* count) {
+  // A node's two children: boxes (min xyz, max xyz each), child indices (~first triangle for a
+  // leaf) and leaf triangle counts. Scalars, not arrays: the traversal loop indexes them by a
+  // run-time child, and an array indexed so would live in local memory on the GPU.
+  struct Children {
+    float b[12];
+    int32_t child0, child1;
+    uint32_t count0, count1;
+  };
+
+  PVR_HOST_DEVICE static Children loadNode(const BvhNode* node) {
+    Children c;
 #ifdef __CUDA_ARCH__
     const float4* p = reinterpret_cast<const float4*>(node);
     float4 q0 = __ldg(p), q1 = __ldg(p + 1), q2 = __ldg(p + 2);
     int4 q3 = __ldg(reinterpret_cast<const int4*>(p + 3));
-    b[0] = q0.x, b[1] = q0.y, b[2] = q0.z, b[3] = q0.w, b[4] = q1.x, b[5] = q1.y;
-    b[6] = q1.z, b[7] = q1.w, b[8] = q2.x, b[9] = q2.y, b[10] = q2.z, b[11] = q2.w;
-    child[0] = q3.x, child[1] = q3.y, count[0] = uint32_t(q3.z), count[1] = uint32_t(q3.w);
+    c.b[0] = q0.x, c.b[1] = q0.y, c.b[2] = q0.z, c.b[3] = q0.w, c.b[4] = q1.x, c.b[5] = q1.y;
+    c.b[6] = q1.z, c.b[7] = q1.w, c.b[8] = q2.x, c.b[9] = q2.y, c.b[10] = q2.z, c.b[11] = q2.w;
+    c.child0 = q3.x, c.child1 = q3.y, c.count0 = uint32_t(q3.z), c.count1 = uint32_t(q3.w);
 #else
-    for (int i = 0; i < 12; ++i) b[i] = node->bounds[i];
-    child[0] = node->child[0], child[1] = node->child[1], count[0] = node->count[0], count[1] = node->count[1];
+    for (int i = 0; i < 12; ++i) c.b[i] = node->bounds[i];
+    c.child0 = node->child[0], c.child1 = node->child[1], c.count0 = node->count[0], c.count1 = node->count[1];
 #endif
+    return c;
   }
 
   // Slab test of one child box: entry distance in tEnter, false if the ray misses it in (0, tMax).
@@ -132,60 +155,58 @@ struct BvhIntersector {
 
   template <bool AnyHit>
   PVR_HOST_DEVICE bool traverse(const Ray& ray, float tMax, Hit& hit) const {
+    if (bvh.nodeCount == 0) return false;
     WatertightRay wr(ray);
     Vec3 invDir{1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};
     int32_t localStack[kStackSize];  // untouched when the stack is in shared memory
     int sp = 0;
-    auto push = [&](int32_t n) {
-      if (sharedStack) sharedStack[uint32_t(sp) * sharedStride] = n;
-      else localStack[sp] = n;
-      ++sp;
-    };
-    auto pop = [&]() {
-      --sp;
-      return sharedStack ? sharedStack[uint32_t(sp) * sharedStride] : localStack[sp];
-    };
     int32_t node = 0;
     bool found = false;
-    if (bvh.nodeCount == 0) return false;
     while (true) {
-      float b[12];
-      int32_t child[2];
-      uint32_t count[2];
-      loadNode(bvh.nodes + node, b, child, count);
-      float tEnter[2];
-      bool enter[2];
+      const Children n = loadNode(bvh.nodes + node);
+      float tEnter0, tEnter1;
+      bool enter0 = hitBox(n.b, ray.origin, invDir, tMax, tEnter0);
+      bool enter1 = hitBox(n.b + 6, ray.origin, invDir, tMax, tEnter1);
+      // Leaf children: their triangles now, in child order, through one copy of the loop.
+#ifdef __CUDA_ARCH__
+#pragma unroll 1
+#endif
       for (int c = 0; c < 2; ++c) {
-        enter[c] = hitBox(b + 6 * c, ray.origin, invDir, tMax, tEnter[c]);
-        if (enter[c] && child[c] < 0) {  // a leaf: test its triangles now
-          enter[c] = false;
-          const BvhTriangle* tri = bvh.triangles + ~child[c];
-          for (uint32_t i = 0; i < count[c]; ++i) {
-            Vec3 v0, v1, v2;
-            uint32_t prim;
-            loadBvhTriangle(tri + i, v0, v1, v2, prim);
-            float t, u, v;
-            if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
-              if (alphaTest && !alphaScene.alphaPasses(prim, u, v)) continue;
-              if (AnyHit) return true;
-              tMax = t;
-              hit.t = t, hit.u = u, hit.v = v, hit.primId = prim;
-              found = true;
-            }
+        const int32_t child = c == 0 ? n.child0 : n.child1;
+        if (!(c == 0 ? enter0 : enter1) || child >= 0) continue;
+        const BvhTriangle* tri = bvh.triangles + ~child;
+        const uint32_t count = c == 0 ? n.count0 : n.count1;
+        for (uint32_t i = 0; i < count; ++i) {
+          Vec3 v0, v1, v2;
+          uint32_t prim;
+          loadBvhTriangle(tri + i, v0, v1, v2, prim);
+          float t, u, v;
+          if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
+            if (!AlphaMask::passes(alphaScene, prim, u, v)) continue;
+            if (AnyHit) return true;
+            tMax = t;
+            hit.t = t, hit.u = u, hit.v = v, hit.primId = prim;
+            found = true;
           }
         }
       }
-      if (enter[0] && enter[1]) {
-        int nearC = tEnter[1] < tEnter[0] ? 1 : 0;
-        push(child[1 - nearC]);
-        node = child[nearC];
-      } else if (enter[0]) {
-        node = child[0];
-      } else if (enter[1]) {
-        node = child[1];
+      enter0 = enter0 && n.child0 >= 0;
+      enter1 = enter1 && n.child1 >= 0;
+      if (enter0 && enter1) {
+        const bool swap = tEnter1 < tEnter0;
+        const int32_t farChild = swap ? n.child0 : n.child1;
+        if (sharedStack) sharedStack[uint32_t(sp) * sharedStride] = farChild;
+        else localStack[sp] = farChild;
+        ++sp;
+        node = swap ? n.child1 : n.child0;
+      } else if (enter0) {
+        node = n.child0;
+      } else if (enter1) {
+        node = n.child1;
       } else {
         if (sp == 0) break;
-        node = pop();
+        --sp;
+        node = sharedStack ? sharedStack[uint32_t(sp) * sharedStride] : localStack[sp];
       }
     }
     return found;

@@ -40,9 +40,9 @@ PVR_HOST_DEVICE inline float wideBvhPlane(uint32_t q, float step, float origin) 
 
 struct WideBvhIntersector {
   WideBvhView bvh;
-  // Alpha masking (any-hit): with alphaTest, hits on texels a material cuts out are skipped.
-  bool alphaTest = false;
-  SceneView alphaScene;
+  // Alpha masking (any-hit): non-null, hits on texels its materials cut out are skipped (a pointer,
+  // as BvhIntersector's).
+  const SceneView* alphaScene = nullptr;
   // Where this thread keeps its traversal stack: word i at sharedStack[i * sharedStride], a column
   // of its block's shared memory (cuda::withSharedStack); null: an array in local memory, which
   // the GPU writes through to L2.
@@ -186,7 +186,7 @@ struct WideBvhIntersector {
         loadBvhTriangle(bvh.triangles + triangleBase + uint32_t(b), v0, v1, v2, prim);
         float t, u, v;
         if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
-          if (alphaTest && !alphaScene.alphaPasses(prim, u, v)) continue;
+          if (!AlphaMask::passes(alphaScene, prim, u, v)) continue;
           if (AnyHit) return true;
           tMax = t;
           hit.t = t, hit.u = u, hit.v = v, hit.primId = prim;

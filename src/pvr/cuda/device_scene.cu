@@ -47,8 +47,8 @@ void DeviceScene::upload(const Scene& scene, const Bvh& bvh) {
   view.punctualLights = host.punctualCount ? punctualLights.data() : nullptr;
   for (int set = 0; set < 2; ++set) view.uvs[set] = host.uvs[set] ? uvs[set].data() : nullptr;
   view.textures = deviceTextures.empty() ? nullptr : textures.data();
-  intersector.alphaTest = scene.hasAlphaTestedMaterial();
-  intersector.alphaScene = view;
+  viewOnDevice.upload(&view, 1, "scene view");
+  intersector.alphaScene = scene.hasAlphaTestedMaterial() ? viewOnDevice.data() : nullptr;
   intersector.bvh = {nodes.data(), triangles.data(), uint32_t(bvh.nodes().size()), uint32_t(bvh.triangles().size())};
 }
 

@@ -26,6 +26,7 @@ struct DeviceScene {
   DeviceBuffer<BvhNode> nodes;
   DeviceBuffer<BvhTriangle> triangles;
   SceneView view;
+  DeviceBuffer<SceneView> viewOnDevice;  ///< `view` in device memory: the intersectors' alpha masks read it
   SceneIntersector intersector;
 
   void upload(const Scene& scene, const Bvh& bvh);

@@ -82,6 +82,10 @@ struct SceneView {
 
   PVR_HOST_DEVICE const Material& material(uint32_t prim) const { return materials[materialIds[prim]]; }
 
+  // A select, not uvs[set]: a run-time index into the array would put a kernel's copy of the
+  // whole view in GPU local memory.
+  PVR_HOST_DEVICE const Vec2* uvSet(uint32_t set) const { return (set & 1u) ? uvs[1] : uvs[0]; }
+
   PVR_HOST_DEVICE void triangle(uint32_t prim, Vec3& a, Vec3& b, Vec3& c) const {
     a = vertices[indices[3 * prim]];
     b = vertices[indices[3 * prim + 1]];
@@ -120,7 +124,7 @@ struct SceneView {
   // against the interpolated normal. A bent normal that would face away from the surface, or a
   // triangle without a usable UV mapping, keeps the unbent one.
   PVR_HOST_DEVICE Vec3 normalMapped(const Material& m, uint32_t prim, float u, float v, Vec3 n, Vec3 geometric) const {
-    const Vec2* t = uvs[m.normalTexture.texCoord & 1u];
+    const Vec2* t = uvSet(m.normalTexture.texCoord);
     if (!t) return n;
     Vec3 a, b, c;
     triangle(prim, a, b, c);
@@ -154,7 +158,7 @@ struct SceneView {
 
   // Texture coordinates of a point (barycentrics u, v) on a triangle; (0, 0) without that set.
   PVR_HOST_DEVICE Vec2 uvAt(uint32_t prim, float u, float v, uint32_t set) const {
-    const Vec2* t = uvs[set & 1u];
+    const Vec2* t = uvSet(set);
     if (!t) return {0.0f, 0.0f};
     Vec2 a = t[indices[3 * prim]], b = t[indices[3 * prim + 1]], c = t[indices[3 * prim + 2]];
     float w = 1.0f - u - v;
@@ -163,7 +167,7 @@ struct SceneView {
 
   // Area of a triangle in a texture reference's (transformed) UV space.
   PVR_HOST_DEVICE float uvArea(uint32_t prim, const TextureRef& ref) const {
-    const Vec2* t = uvs[ref.texCoord & 1u];
+    const Vec2* t = uvSet(ref.texCoord);
     if (!t) return 0.0f;
     Vec2 a = t[indices[3 * prim]], b = t[indices[3 * prim + 1]], c = t[indices[3 * prim + 2]];
     float cross2 = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
