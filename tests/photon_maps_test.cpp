@@ -155,6 +155,80 @@ TEST(PhotonMaps, KnnReturnsTheTrueKNearest) {
   }
 }
 
+// The k nearest by searchNearest (rows nearest first, rows and cells beyond the shrinking radius
+// skipped): brute force's distances for every k, also where float rounding is coarse against the
+// cell (photons 1000 units from the origin, cells of 0.01), for queries on cell faces and
+// corners, outside the photons' bounds, and with ties.
+std::vector<float> kNearestByBruteForce(const std::vector<Photon>& photons, Vec3 q, float r2, int k) {
+  std::vector<float> all;
+  for (const Photon& p : photons)
+    if (photonDistance2(q, p.position) <= r2) all.push_back(photonDistance2(q, p.position));
+  std::sort(all.begin(), all.end());
+  all.resize(std::min<size_t>(all.size(), size_t(k)));
+  return all;
+}
+
+template <class View>
+std::vector<float> kNearestBySearchNearest(const View& view, Vec3 q, float r2, int k, int* visits = nullptr) {
+  KnnHeap heap(k);
+  view.searchNearest(q, r2, [&](uint32_t i, float d2, float& sr2) {
+    if (visits) ++*visits;
+    heap.offer(d2, i, sr2);
+  });
+  std::vector<float> d(heap.dist2, heap.dist2 + heap.size);
+  std::sort(d.begin(), d.end());
+  return d;
+}
+
+TEST(PhotonMaps, NearestFirstKnnMatchesBruteForce) {
+  std::mt19937 rng(21);
+  for (Vec3 offset : {Vec3{0, 0, 0}, Vec3{1000, -1000, 1000}}) {
+    const float r = offset.x == 0 ? 0.1f : 0.01f;
+    const Vec3 lo = offset + Vec3{-0.5f, 0, -0.5f} * (r * 10), hi = offset + Vec3{0.5f, 1, 0.5f} * (r * 10);
+    auto photons = randomPhotons(rng, 4000, lo, hi);
+    for (int i = 0; i < 60; ++i) photons.push_back(photons[i]);  // ties
+    HashGrid grid = HashGrid::build(photons, r);
+    KdTree tree = KdTree::build(photons);
+    const HashGridView v = grid.view();
+    std::vector<Vec3> queries;
+    for (const Photon& p : randomPhotons(rng, 200, lo - Vec3(r), hi + Vec3(r))) queries.push_back(p.position);
+    for (int i = 0; i < 100; ++i) {  // on cell faces, edges and corners, as the grid computes them
+      Vec3 q = queries[size_t(i)];
+      for (int a = 0; a < 3 - i % 3; ++a) q[a] = v.origin[a] + std::floor((q[a] - v.origin[a]) * v.invCellSize) * v.cellSize;
+      queries.push_back(q);
+    }
+    for (int i = 0; i < 40; ++i) queries.push_back(photons[size_t(i)].position);  // on photons
+    for (int k : {1, 4, 16, 32, 64}) {
+      for (Vec3 q : queries) {
+        const float r2 = r * r;
+        const std::vector<float> expected = kNearestByBruteForce(photons, q, r2, k);
+        ASSERT_EQ(kNearestBySearchNearest(v, q, r2, k), expected)
+            << "hash grid, k=" << k << " at " << q.x << "," << q.y << "," << q.z;
+        ASSERT_EQ(kNearestBySearchNearest(tree.view(), q, r2, k), expected) << "kd-tree, k=" << k;
+      }
+    }
+  }
+}
+
+// The point of searching nearest first: once the heap is full, fewer photons are offered to it.
+TEST(PhotonMaps, NearestFirstKnnOffersFewerPhotons) {
+  std::mt19937 rng(22);
+  auto photons = randomPhotons(rng, 20000, {0, 0, 0}, {1, 1, 1});
+  HashGrid grid = HashGrid::build(photons, 0.1f);
+  int nearestVisits = 0, plainVisits = 0;
+  for (const Photon& qp : randomPhotons(rng, 300, {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f})) {
+    kNearestBySearchNearest(grid.view(), qp.position, 0.01f, 8, &nearestVisits);
+    KnnHeap heap(8);
+    float r2 = 0.01f;
+    grid.view().search(qp.position, r2, [&](uint32_t i, float d2, float& sr2) {
+      ++plainVisits;
+      heap.offer(d2, i, sr2);
+    });
+  }
+  // About 84 photons lie within r of a query, the 8 nearest within about r/2.
+  EXPECT_LT(nearestVisits, plainVisits * 0.8) << nearestVisits << " against " << plainVisits;
+}
+
 TEST(PhotonMaps, KdTreeIsACompleteBalancedSplitTree) {
   for (uint32_t n : {1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 100u, 1023u, 1024u, 1025u}) {
     // A complete binary tree of n nodes: left subtree sizes add up and nodes fill 0..n-1.

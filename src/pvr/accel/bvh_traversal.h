@@ -162,6 +162,7 @@ struct BvhIntersector {
     int sp = 0;
     int32_t node = 0;
     bool found = false;
+    Hit closest;  // in registers until the end: `hit` may live in the caller's local memory
     while (true) {
       const Children n = loadNode(bvh.nodes + node);
       float tEnter0, tEnter1;
@@ -185,7 +186,7 @@ struct BvhIntersector {
             if (!AlphaMask::passes(alphaScene, prim, u, v)) continue;
             if (AnyHit) return true;
             tMax = t;
-            hit.t = t, hit.u = u, hit.v = v, hit.primId = prim;
+            closest.t = t, closest.u = u, closest.v = v, closest.primId = prim;
             found = true;
           }
         }
@@ -209,6 +210,7 @@ struct BvhIntersector {
         node = sharedStack ? sharedStack[uint32_t(sp) * sharedStride] : localStack[sp];
       }
     }
+    if (found) hit = closest;
     return found;
   }
 };

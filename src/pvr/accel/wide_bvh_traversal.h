@@ -138,6 +138,7 @@ struct WideBvhIntersector {
     // inner mask by slot. The root is the only child of a virtual node, in slot 0.
     uint32_t groupBase = 0, group = (1u << nearSide) | (1u << 8);
     bool found = false;
+    Hit closest;  // in registers until the end: `hit` may live in the caller's local memory
     while (true) {
       if ((group & 0xffu) == 0) {
         if (sp == 0) break;
@@ -189,13 +190,14 @@ struct WideBvhIntersector {
           if (!AlphaMask::passes(alphaScene, prim, u, v)) continue;
           if (AnyHit) return true;
           tMax = t;
-          hit.t = t, hit.u = u, hit.v = v, hit.primId = prim;
+          closest.t = t, closest.u = u, closest.v = v, closest.primId = prim;
           found = true;
         }
       }
       groupBase = w[4];
       group = innerKeys | (innerMask << 8);
     }
+    if (found) hit = closest;
     return found;
   }
 

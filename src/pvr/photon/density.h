@@ -82,7 +82,7 @@ PVR_HOST_DEVICE Vec3 estimateFluxDensity(const PhotonMap& map, Vec3 x, Vec3 n, c
     return sum * (1.0f / (kPi * r2));
   }
   KnnHeap heap(params.k);
-  map.search(x, r2, [&](uint32_t i, float d2, float& searchR2) {
+  map.searchNearest(x, r2, [&](uint32_t i, float d2, float& searchR2) {
     const Photon& p = map.photons[i];
     if (photonCounts(p.position - x, p.direction, n, wall)) heap.offer(d2, i, searchR2);
   });

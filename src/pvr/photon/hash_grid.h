@@ -72,6 +72,59 @@ struct HashGridView {
       }
     }
   }
+
+  // The same visits for searches that shrink r2 (kNN): the 9 rows nearest first (the query's own,
+  // then those across its cell's nearer faces, then the farther ones), and a row, or its x-1 or
+  // x+1 cell, skipped when its nearest point is farther than r2 has become. A skipped cell holds
+  // no photon the visitor would still take, so the k nearest are the same as search's.
+  template <class Visitor>
+  PVR_HOST_DEVICE void searchNearest(Vec3 q, float& r2, Visitor&& visit) const {
+    if (photonCount == 0) return;
+    const int64_t center = cellOf(q);
+    if (center < 0) return;
+    const uint32_t c = uint32_t(center), slab = uint32_t(dims[0]) * uint32_t(dims[1]);
+    float gxLo, gxHi, gyLo, gyHi, gzLo, gzHi;
+    faceGaps(q.x, origin.x, int(c % uint32_t(dims[0])), gxLo, gxHi);
+    faceGaps(q.y, origin.y, int((c / uint32_t(dims[0])) % uint32_t(dims[1])), gyLo, gyHi);
+    faceGaps(q.z, origin.z, int(c / slab), gzLo, gzHi);
+    const int ny = gyLo <= gyHi ? -1 : 1, nz = gzLo <= gzHi ? -1 : 1;  // the nearer neighbours
+    const float gyNear2 = sq(fminf(gyLo, gyHi)), gyFar2 = sq(fmaxf(gyLo, gyHi));
+    const float gzNear2 = sq(fminf(gzLo, gzHi)), gzFar2 = sq(fmaxf(gzLo, gzHi));
+    const float gxLo2 = sq(gxLo), gxHi2 = sq(gxHi);
+    // Row k's y and z neighbour, 2 bits each: 0 the query's own, 1 the nearer, 2 the farther.
+    // Order (y, z): (0,0) (1,0) (0,1) (1,1) (2,0) (0,2) (1,2) (2,1) (2,2).
+    constexpr uint32_t kRowY = 0b10'10'01'00'10'01'00'01'00u, kRowZ = 0b10'01'10'10'00'01'01'00'00u;
+#ifdef __CUDA_ARCH__
+#pragma unroll 1
+#endif
+    for (int row = 0; row < 9; ++row) {
+      const uint32_t ySide = (kRowY >> (2 * row)) & 3u, zSide = (kRowZ >> (2 * row)) & 3u;
+      const float rowGap2 = (ySide == 0 ? 0.0f : (ySide == 1 ? gyNear2 : gyFar2)) +
+                            (zSide == 0 ? 0.0f : (zSide == 1 ? gzNear2 : gzFar2));
+      if (rowGap2 > r2) continue;
+      const int dy = ySide == 0 ? 0 : (ySide == 1 ? ny : -ny), dz = zSide == 0 ? 0 : (zSide == 1 ? nz : -nz);
+      const uint32_t first = uint32_t(int64_t(c) + int64_t(dz) * slab + int64_t(dy) * dims[0] - 1);
+      const uint32_t begin = cellStart[first + (rowGap2 + gxLo2 <= r2 ? 0 : 1)];
+      const uint32_t end = cellStart[first + (rowGap2 + gxHi2 <= r2 ? 3 : 2)];
+      for (uint32_t i = begin; i < end; ++i) {
+        const float d2 = photonDistance2(q, position(i));
+        if (d2 <= r2) visit(i, d2, r2);
+      }
+    }
+  }
+
+ private:
+  PVR_HOST_DEVICE static float sq(float x) { return x * x; }
+
+  // Distances from the coordinate x to the lower and upper faces of cell `cell` along one axis,
+  // each lowered by a margin (a thousandth of a cell, plus the coordinate's float rounding) that
+  // covers photons binned by cellOf's float arithmetic across a face; never negative.
+  PVR_HOST_DEVICE void faceGaps(float x, float axisOrigin, int cell, float& lo, float& hi) const {
+    const float f = (x - axisOrigin) * invCellSize;
+    const float margin = 1e-3f + 1e-6f * fabsf(f);
+    lo = fmaxf(0.0f, (f - float(cell) - margin) * cellSize);
+    hi = fmaxf(0.0f, (float(cell + 1) - f - margin) * cellSize);
+  }
 };
 
 // Host-side owner of a hash grid, built on the CPU with a stable counting sort by cell.

@@ -15,6 +15,13 @@ struct KdTreeView {
 
   static constexpr int kStackSize = 64;  ///< > depth of any tree of 2^32 nodes
 
+  // For searches that shrink r2 (kNN): the tree's search already descends nearest first and
+  // skips subtrees beyond r2.
+  template <class Visitor>
+  PVR_HOST_DEVICE void searchNearest(Vec3 q, float& r2, Visitor&& visit) const {
+    search(q, r2, visit);
+  }
+
   // Visits every photon with photonDistance2 <= r2; `visit(index, d2, r2)` may shrink r2.
   template <class Visitor>
   PVR_HOST_DEVICE void search(Vec3 q, float& r2, Visitor&& visit) const {
