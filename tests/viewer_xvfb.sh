@@ -13,7 +13,8 @@ command -v xvfb-run >/dev/null || fail "xvfb-run is not installed (package xvfb)
 # then traced with the density disc clipped at walls (the panel's checkbox, kept in the settings).
 for run in rays:sphere raster:sphere rays:clipped; do
   mode=${run%%:*} boundary=${run##*:}
-  timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" "$exe" view --backend cpu --eye-size 64x72 --photons 64x64 \
+  # Our own X authority file, not xvfb-run's temporary directory (whose removal can fail: exit 5).
+  timeout 120 xvfb-run -a -f "$out/xauthority" -s "-screen 0 1024x768x24" "$exe" view --backend cpu --eye-size 64x72 --photons 64x64 \
     --primary $mode --boundary $boundary --keys 2:F12,4:Escape --screenshot "$out/shot" >"$out/log" 2>&1
   rc=$?
   cat "$out/log"

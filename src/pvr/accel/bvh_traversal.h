@@ -92,6 +92,21 @@ struct AlphaMask {
   }
 };
 
+// One leaf triangle against the ray, for both BVH layouts: true for a hit before tMax that the
+// alpha mask keeps, which then becomes `closest` and shortens tMax.
+PVR_HOST_DEVICE inline bool hitLeafTriangle(const WatertightRay& wr, const BvhTriangle* tri, const SceneView* alphaScene,
+                                            float& tMax, Hit& closest) {
+  Vec3 v0, v1, v2;
+  uint32_t prim;
+  loadBvhTriangle(tri, v0, v1, v2, prim);
+  float t, u, v;
+  if (!intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) return false;
+  if (!AlphaMask::passes(alphaScene, prim, u, v)) return false;
+  tMax = t;
+  closest.t = t, closest.u = u, closest.v = v, closest.primId = prim;
+  return true;
+}
+
 struct BvhIntersector {
   BvhView bvh;
   // Alpha masking (any-hit): non-null, hits on texels its materials cut out are skipped. A pointer
@@ -178,17 +193,9 @@ struct BvhIntersector {
         const BvhTriangle* tri = bvh.triangles + ~child;
         const uint32_t count = c == 0 ? n.count0 : n.count1;
         for (uint32_t i = 0; i < count; ++i) {
-          Vec3 v0, v1, v2;
-          uint32_t prim;
-          loadBvhTriangle(tri + i, v0, v1, v2, prim);
-          float t, u, v;
-          if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
-            if (!AlphaMask::passes(alphaScene, prim, u, v)) continue;
-            if (AnyHit) return true;
-            tMax = t;
-            closest.t = t, closest.u = u, closest.v = v, closest.primId = prim;
-            found = true;
-          }
+          if (!hitLeafTriangle(wr, tri + i, alphaScene, tMax, closest)) continue;
+          if (AnyHit) return true;
+          found = true;
         }
       }
       enter0 = enter0 && n.child0 >= 0;

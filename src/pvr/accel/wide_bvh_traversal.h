@@ -182,17 +182,9 @@ struct WideBvhIntersector {
       while (triangleBits) {
         const int b = lowestBit(triangleBits);
         triangleBits &= triangleBits - 1u;
-        Vec3 v0, v1, v2;
-        uint32_t prim;
-        loadBvhTriangle(bvh.triangles + triangleBase + uint32_t(b), v0, v1, v2, prim);
-        float t, u, v;
-        if (intersectTriangleWatertight(wr, v0, v1, v2, 0.0f, tMax, t, u, v)) {
-          if (!AlphaMask::passes(alphaScene, prim, u, v)) continue;
-          if (AnyHit) return true;
-          tMax = t;
-          closest.t = t, closest.u = u, closest.v = v, closest.primId = prim;
-          found = true;
-        }
+        if (!hitLeafTriangle(wr, bvh.triangles + triangleBase + uint32_t(b), alphaScene, tMax, closest)) continue;
+        if (AnyHit) return true;
+        found = true;
       }
       groupBase = w[4];
       group = innerKeys | (innerMask << 8);
