@@ -11,7 +11,8 @@ namespace pvr::cuda {
 
 // The renderer's ray queries: the binary BVH. The 8-wide quantized BVH (wide_bvh.h) traces 2-3x
 // faster in standalone ray kernels (bench --suite rays) but made the eye kernels slower on the
-// H200, inlined or not (docs/benchmarks.md, 2026-12-05), so it is not used here yet.
+// H200, inlined or not (docs/benchmarks.md, 2026-12-05), so it is not used here yet. Those
+// figures predate the binary traversal's local-memory fix (529141c): to be measured again.
 using SceneIntersector = BvhIntersector;
 
 struct DeviceScene {
