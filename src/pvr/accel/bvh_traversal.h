@@ -132,8 +132,9 @@ struct BvhIntersector {
 
  private:
   // A node's two children: boxes (min xyz, max xyz each), child indices (~first triangle for a
-  // leaf) and leaf triangle counts. Scalars, not arrays: the traversal loop indexes them by a
-  // run-time child, and an array indexed so would live in local memory on the GPU.
+  // leaf) and leaf triangle counts. The boxes are read at constant indices only; children and
+  // counts are scalars, because the loop picks them by a run-time child, and an array indexed so
+  // would live in local memory on the GPU.
   struct Children {
     float b[12];
     int32_t child0, child1;
