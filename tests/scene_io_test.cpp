@@ -89,6 +89,7 @@ TEST(SceneErrors, EachBadInputThrowsAClearError) {
       {kData + "/not_a_scene.txt", "unsupported scene format '.txt'"},
       {kData + "/malformed.json", "malformed JSON"},
       {kData + "/malformed.gltf", "cannot read"},
+      {kData + "/primitive_without_positions.gltf", "mesh 0 primitive 0 has no POSITION attribute"},
       {kData + "/no_light.json", "has no light"},
       {"cornel", "no such file or built-in scene"},
   };

@@ -378,6 +378,19 @@ void checkGltfRanges(const GltfFile& file, const std::string& path) {
         (count - 1) * stride + element > viewBytes[view] - offset)
       malformed("accessor " + std::to_string(a) + " reads past the end of bufferView " + std::to_string(view));
   }
+  // assimp 5.2 sizes a primitive without positions from a vertex count of zero, and a strip or
+  // fan then asks for ~64 GB. The spec lets viewers skip such primitives; we refuse the file.
+  const json meshes = array("meshes");
+  for (size_t m = 0; m < meshes.size(); ++m) {
+    if (!meshes[m].is_object() || !meshes[m].contains("primitives") || !meshes[m]["primitives"].is_array()) continue;
+    const json& primitives = meshes[m]["primitives"];
+    for (size_t p = 0; p < primitives.size(); ++p) {
+      const json& primitive = primitives[p];
+      if (!primitive.is_object() || !primitive.contains("attributes") || !primitive["attributes"].is_object() ||
+          !primitive["attributes"].contains("POSITION"))
+        malformed("mesh " + std::to_string(m) + " primitive " + std::to_string(p) + " has no POSITION attribute");
+    }
+  }
 }
 
 // A glTF node's local transform, column-major: its "matrix", or translation * rotation * scale.

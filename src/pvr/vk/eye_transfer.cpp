@@ -225,7 +225,7 @@ void EyeTransfer::handOver(const EyeSource source[2], const EyeTarget target[2],
   const size_t pixels = size_t(options_.width) * options_.height;
   const int bpp = displayBytesPerPixel(options_.encoding);
   bool anyCuda = false;
-  void* stream = nullptr;  // the renderer's: its next frame cannot overwrite the images before the encode read them
+  [[maybe_unused]] void* stream = nullptr;  // the renderer's: its next frame cannot overwrite the images before the encode read them
   auto hostStart = std::chrono::steady_clock::now();
   for (int e = 0; e < 2; ++e) {
     const EyeSource& src = source[e];
