@@ -90,6 +90,7 @@ TEST(SceneErrors, EachBadInputThrowsAClearError) {
       {kData + "/malformed.json", "malformed JSON"},
       {kData + "/malformed.gltf", "cannot read"},
       {kData + "/primitive_without_positions.gltf", "mesh 0 primitive 0 has no POSITION attribute"},
+      {kData + "/invalid_utf8.gltf", "not valid JSON (at byte"},
       {kData + "/no_light.json", "has no light"},
       {"cornel", "no such file or built-in scene"},
   };

@@ -312,7 +312,13 @@ std::optional<GltfFile> readGltfFile(const std::string& path) {
   } else {
     text = std::move(bytes);
   }
-  file.doc = nlohmann::json::parse(text, nullptr, false);
+  // assimp's parser lets invalid UTF-8 through and then misreads what follows (a fuzzer finding):
+  // JSON that is not valid is refused here.
+  try {
+    file.doc = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error("malformed glTF '" + path + "': not valid JSON (at byte " + std::to_string(e.byte) + ")");
+  }
   return file;
 }
 
@@ -322,7 +328,7 @@ std::optional<GltfFile> readGltfFile(const std::string& path) {
 void checkGltfRanges(const GltfFile& file, const std::string& path) {
   using nlohmann::json;
   const json& doc = file.doc;
-  if (doc.is_discarded() || !doc.is_object()) return;  // assimp reports unreadable JSON itself
+  if (!doc.is_object()) return;  // assimp reports a glTF that is not an object
   auto malformed = [&](const std::string& why) { throw Error("malformed glTF '" + path + "': " + why); };
   auto array = [&](const char* key) { return doc.contains(key) && doc[key].is_array() ? doc[key] : json::array(); };
   auto number = [](const json& o, const char* key, uint64_t fallback) {
