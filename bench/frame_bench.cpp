@@ -14,6 +14,7 @@
 #include "pvr/cpu/cpu_backend.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/image/image_compare.h"
+#include "pvr/photon/kd_tree.h"
 #include "pvr/reference/progressive_reference.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
@@ -773,6 +774,29 @@ int runGrid(const FrameBenchArgs& args, nlohmann::json& json) {
     json.push_back({{"suite", "grid"}, {"photons", photons.size()}, {"radius", radius},
                     {"cells", cpu.cellStart().size() - 1}, {"repeats", repeats}, {"gpu_build_ms", gpuBuild.p50},
                     {"gpu_build", gpuBuild}, {"cpu_build_ms", cpuMs}, {"check", ok ? "ok" : "MISMATCH"}});
+  }
+  std::printf("\nKd-tree build on the GPU (level by level: ranks by three stable radix sorts, then per level node "
+              "bounds and one radix sort of the slots by (node, rank along its axis)) against the CPU build "
+              "(recursive nth_element, TBB), the same tree; %d builds each\n\n"
+              "| photons | GPU build ms (median / p99 / max) | CPU build ms | check vs CPU |\n|---|---|---|---|\n",
+              repeats);
+  for (size_t count : {size_t(1) << 16, size_t(1) << 18, photons.size()}) {
+    std::vector<Photon> subset(photons.begin(), photons.begin() + std::min(count, photons.size()));
+    GpuKdTreeCopy copy;
+    std::vector<double> buildMs;
+    for (int r = 0; r < repeats; ++r) buildMs.push_back(gpu.buildKdTree(subset, 1, r + 1 == repeats ? &copy : nullptr));
+    const LatencyStats gpuBuild = latencyStats(buildMs);
+    auto start = Clock::now();
+    KdTree cpu = KdTree::build(subset);
+    double cpuMs = msSince(start);
+    bool ok = copy.nodeToInput == cpu.nodeToInput() &&
+              std::equal(copy.axes.begin(), copy.axes.end(), cpu.view().axes);
+    failures += ok ? 0 : 1;
+    std::printf("| %zu | %.3f / %.3f / %.3f | %.1f | %s |\n", subset.size(), gpuBuild.p50, gpuBuild.p99, gpuBuild.max,
+                cpuMs, ok ? "ok (identical)" : "MISMATCH");
+    json.push_back({{"suite", "grid"}, {"map", "kd-tree"}, {"photons", subset.size()}, {"repeats", repeats},
+                    {"gpu_build_ms", gpuBuild.p50}, {"gpu_build", gpuBuild}, {"cpu_build_ms", cpuMs},
+                    {"check", ok ? "ok" : "MISMATCH"}});
   }
   return failures;
 }

@@ -15,6 +15,7 @@
 #include "pvr/cuda/image_checks.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/image/image_compare.h"
+#include "pvr/photon/kd_tree.h"
 #include "pvr/reference/progressive_reference.h"
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
@@ -109,6 +110,34 @@ TEST(GpuBackend, HashGridMatchesTheCpuBuildExactly) {
     EXPECT_EQ(copy.sortedToInput, cpu.sortedToInput()) << radius;
     ASSERT_EQ(copy.photons.size(), cpu.photons().size());
     for (size_t i = 0; i < copy.photons.size(); ++i) ASSERT_TRUE(copy.photons[i].position == cpu.photons()[i].position);
+  }
+}
+
+TEST(GpuBackend, KdTreeMatchesTheCpuBuildExactly) {
+  PVR_REQUIRE_GPU();
+  Scene scene = builtinScene("cornell");
+  CudaFrameBackend gpu(scene);
+  PhotonTraceParams params;
+  params.photonCount = 256 * 256;
+  params.storeDirect = true;
+  std::vector<Photon> traced = gpu.tracePhotonsToHost(params);
+  // Every size from one photon to a few levels, then the traced set, which has coordinates that
+  // tie (photons on the walls share a coordinate): ties are broken by index on both sides.
+  std::vector<size_t> sizes;
+  for (size_t n = 1; n <= 70; ++n) sizes.push_back(n);
+  sizes.push_back(4095), sizes.push_back(4097), sizes.push_back(traced.size());
+  for (size_t n : sizes) {
+    std::vector<Photon> photons(traced.begin(), traced.begin() + std::min(n, traced.size()));
+    GpuKdTreeCopy copy;
+    gpu.buildKdTree(photons, 1, &copy);
+    KdTree cpu = KdTree::build(photons);
+    ASSERT_EQ(copy.nodeToInput, cpu.nodeToInput()) << n << " photons";
+    ASSERT_EQ(copy.axes.size(), photons.size());
+    const KdTreeView view = cpu.view();
+    for (size_t i = 0; i < photons.size(); ++i) {
+      ASSERT_EQ(copy.axes[i], view.axes[i]) << n << " photons, node " << i;
+      ASSERT_TRUE(copy.photons[i].position == cpu.photons()[i].position) << n << " photons, node " << i;
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <map>
 #include <random>
 #include <set>
 
@@ -261,6 +262,121 @@ TEST(PhotonMaps, KdTreeIsACompleteBalancedSplitTree) {
     check(2 * node + 2, v.axes[node], split, false);
   }
   EXPECT_EQ(v.axes[0], 0) << "the root splits the longest axis (x)";
+}
+
+// The tree is unique: with coordinates that tie (photons on a lattice), the build equals a plain
+// recursive one that sorts every subtree by (coordinate, index), as the GPU build orders them.
+TEST(PhotonMaps, KdTreeBreaksTiesByIndex) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> lattice(0, 3);
+  std::vector<Photon> photons(3000);
+  for (Photon& p : photons) p.position = Vec3(float(lattice(rng)), float(lattice(rng)) * 0.5f, float(lattice(rng)));
+  std::vector<uint32_t> expected(photons.size());
+  std::function<void(uint32_t, std::vector<uint32_t>)> build = [&](uint32_t node, std::vector<uint32_t> subset) {
+    if (subset.empty()) return;
+    Bounds3 b;
+    for (uint32_t i : subset) b.extend(photons[i].position);
+    const int axis = b.longestAxis();
+    std::sort(subset.begin(), subset.end(), [&](uint32_t x, uint32_t y) {
+      const float px = photons[x].position[axis], py = photons[y].position[axis];
+      return px < py || (px == py && x < y);
+    });
+    const uint32_t median = completeTreeLeftSize(uint32_t(subset.size()));
+    expected[node] = subset[median];
+    build(2 * node + 1, std::vector<uint32_t>(subset.begin(), subset.begin() + median));
+    build(2 * node + 2, std::vector<uint32_t>(subset.begin() + median + 1, subset.end()));
+  };
+  std::vector<uint32_t> all(photons.size());
+  for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+  build(0, all);
+  EXPECT_EQ(KdTree::build(photons).nodeToInput(), expected);
+}
+
+// The GPU build's bookkeeping (kdBuildSlot): after every level's splits each slot of the order
+// array is a node's median or lies in exactly one node still to split; with all levels split,
+// the slots are the nodes 0..n-1, one each, at the depths of a complete tree.
+TEST(PhotonMaps, KdBuildSlotsPlaceEveryNodeOnce) {
+  for (uint32_t n : {1u, 2u, 3u, 5u, 7u, 8u, 9u, 100u, 1023u, 1024u, 1025u}) {
+    const int levels = int(bitWidth(n));
+    std::vector<int> placedAt(n, -1);
+    for (int level = 0; level <= levels; ++level) {
+      std::map<uint32_t, std::pair<uint32_t, uint32_t>> open;  // node -> its slots' range
+      for (uint32_t slot = 0; slot < n; ++slot) {
+        const KdBuildSlot s = kdBuildSlot(n, slot, level);
+        if (s.placed) {
+          ASSERT_LT(s.depth, level);
+          ASSERT_LT(s.node, n);
+          EXPECT_EQ(s.depth, int(bitWidth(s.node + 1)) - 1) << "node " << s.node << " at its depth";
+          if (placedAt[s.node] < 0) placedAt[s.node] = int(slot);
+          EXPECT_EQ(placedAt[s.node], int(slot)) << "node " << s.node << " has one slot";
+          continue;
+        }
+        ASSERT_LT(level, levels) << "every slot is placed after the last level";
+        ASSERT_LE(s.begin, slot);
+        ASSERT_LT(slot, s.end);
+        auto [it, added] = open.emplace(s.node, std::make_pair(s.begin, s.end));
+        EXPECT_EQ(it->second, std::make_pair(s.begin, s.end)) << "one range per node";
+      }
+      uint32_t openSlots = 0;
+      for (const auto& [node, range] : open) openSlots += range.second - range.first;
+      uint32_t placed = 0;
+      for (int slot : placedAt) placed += slot >= 0 ? 1 : 0;
+      EXPECT_EQ(openSlots + placed, n) << n << " photons, level " << level;
+    }
+    for (uint32_t node = 0; node < n; ++node) EXPECT_GE(placedAt[node], 0) << n << " photons, node " << node;
+  }
+}
+
+// The GPU build's algorithm run on the host, one slot at a time, with std::sort for the radix
+// sorts (cuda/photon_map_build.cu runs the same per-slot steps in parallel): ranks along each
+// axis, then per level each node's bounds and longest axis and one sort of the slots by
+// kdSplitKey. It makes the recursive build's tree.
+TEST(PhotonMaps, LevelByLevelBuildMakesTheSameTree) {
+  std::mt19937 rng(21);
+  std::uniform_int_distribution<int> lattice(0, 9);
+  for (uint32_t n : {1u, 2u, 3u, 6u, 31u, 32u, 33u, 1000u, 4097u}) {
+    std::vector<Photon> photons(n);
+    for (Photon& p : photons) p.position = Vec3(float(lattice(rng)), float(lattice(rng)) * 0.3f, float(lattice(rng)) * 2.0f);
+    std::vector<uint32_t> ranks[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<uint32_t> sorted(n);
+      for (uint32_t i = 0; i < n; ++i) sorted[i] = i;
+      std::stable_sort(sorted.begin(), sorted.end(),
+                       [&](uint32_t x, uint32_t y) { return photons[x].position[axis] < photons[y].position[axis]; });
+      ranks[axis].resize(n);
+      for (uint32_t r = 0; r < n; ++r) ranks[axis][sorted[r]] = r;
+    }
+    const int slotBits = int(bitWidth(std::max(n, 2u) - 1));
+    std::vector<uint32_t> slots(n), nodeToInput(n, ~0u);
+    std::vector<uint8_t> axes(n, 255);
+    for (uint32_t i = 0; i < n; ++i) slots[i] = i;
+    const int levels = int(bitWidth(n));
+    for (int level = 0; level <= levels; ++level) {
+      std::map<uint32_t, Bounds3> bounds;
+      for (uint32_t i = 0; i < n; ++i) {
+        const KdBuildSlot s = kdBuildSlot(n, i, level);
+        if (s.placed && s.depth == level - 1) nodeToInput[s.node] = slots[i];
+        if (!s.placed) bounds[s.node].extend(photons[slots[i]].position);
+      }
+      if (level == levels) break;
+      std::vector<std::pair<uint64_t, uint32_t>> keyed(n);
+      for (uint32_t i = 0; i < n; ++i) {
+        const KdBuildSlot s = kdBuildSlot(n, i, level);
+        uint32_t rank = 0;
+        if (!s.placed) {
+          const int axis = bounds[s.node].longestAxis();
+          if (i == s.begin) axes[s.node] = uint8_t(axis);
+          rank = ranks[axis][slots[i]];
+        }
+        keyed[i] = {kdSplitKey(s, i, rank, slotBits), slots[i]};
+      }
+      std::sort(keyed.begin(), keyed.end());
+      for (uint32_t i = 0; i < n; ++i) slots[i] = keyed[i].second;
+    }
+    KdTree tree = KdTree::build(photons);
+    EXPECT_EQ(nodeToInput, tree.nodeToInput()) << n << " photons";
+    EXPECT_TRUE(std::equal(axes.begin(), axes.end(), tree.view().axes)) << n << " photons";
+  }
 }
 
 TEST(PhotonMaps, HashGridLayoutFollowsThePaper) {

@@ -27,6 +27,12 @@ struct GpuHashGridCopy {
   std::vector<uint32_t> cellStart, sortedToInput;
 };
 
+struct GpuKdTreeCopy {
+  std::vector<Photon> photons;  ///< in node order
+  std::vector<uint8_t> axes;
+  std::vector<uint32_t> nodeToInput;
+};
+
 class CudaFrameBackend : public FrameBackend {
  public:
   // Throws pvr::Error if no GPU can be used, or the scene does not fit on it.
@@ -58,6 +64,9 @@ class CudaFrameBackend : public FrameBackend {
   // in ms (CUDA events, cell keys to gathered photons; the photons' bounds are given, as the
   // tracer reduces them while tracing) and optionally the grid.
   double buildHashGrid(const std::vector<Photon>& photons, float radius, int repeats, GpuHashGridCopy* copy = nullptr);
+  // Builds the kd-tree over `photons` on the GPU `repeats` times; returns the median build time
+  // in ms (CUDA events) and optionally the tree.
+  double buildKdTree(const std::vector<Photon>& photons, int repeats, GpuKdTreeCopy* copy = nullptr);
   const BvhBuildStats& bvhStats() const;
   size_t deviceBytes() const;  ///< GPU memory held by this backend now
   const cuda::DeviceScene& deviceScene() const;

@@ -2,7 +2,6 @@
 #include <cub/device/device_scan.cuh>
 
 #include <algorithm>
-#include <chrono>
 
 #include "pvr/cuda/photon_map_build.cuh"
 
@@ -27,6 +26,106 @@ __global__ void gatherPhotonsKernel(const Photon* photons, const uint32_t* order
   Photon p = photons[order[i]];
   sorted[i] = p;
   positions[i] = {p.position.x, p.position.y, p.position.z, 0.0f};
+}
+
+
+// The kd-tree build (GpuKdTree::build).
+
+// A float's bits, ordered as the floats are (-0 as +0, so that ties are those of the CPU's <).
+__device__ inline uint32_t orderedBits(float v) {
+  const uint32_t b = __float_as_uint(v == 0.0f ? 0.0f : v);
+  return (b & 0x80000000u) ? ~b : (b | 0x80000000u);
+}
+__device__ inline float fromOrderedBits(uint32_t o) { return __uint_as_float((o & 0x80000000u) ? (o & 0x7fffffffu) : ~o); }
+
+__global__ void kdRankKeysKernel(const Photon* photons, uint32_t n, int axis, uint32_t* keys, uint32_t* values) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  keys[i] = orderedBits(photons[i].position[axis]);
+  values[i] = i;  // the sort is stable: equal coordinates stay in index order
+}
+
+__global__ void kdRanksKernel(const uint32_t* sorted, uint32_t n, uint32_t* ranks) {
+  const uint32_t r = blockIdx.x * blockDim.x + threadIdx.x;
+  if (r < n) ranks[sorted[r]] = r;
+}
+
+__global__ void kdIdentityKernel(uint32_t* slots, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) slots[i] = i;
+}
+
+struct KdBuildArrays {
+  const Photon* photons;
+  uint32_t count;
+  const uint32_t* ranks;  ///< [axis * rankStride + photon]
+  uint32_t rankStride;
+  uint32_t *lower, *upper;  ///< node bounds as orderedBits, [node * 3 + axis]
+  uint8_t* axes;
+  Photon* treePhotons;
+  uint32_t* nodeToInput;
+  int slotBits;
+};
+
+__device__ inline Bounds3 kdNodeBounds(const KdBuildArrays& a, uint32_t node) {
+  Bounds3 b;
+  for (int k = 0; k < 3; ++k) {
+    b.lower[k] = fromOrderedBits(a.lower[node * 3 + k]);
+    b.upper[k] = fromOrderedBits(a.upper[node * 3 + k]);
+  }
+  return b;
+}
+
+// Slot by slot: a median placed at the level above becomes its node's photon; a photon still to
+// split adds its position to its node's bounds (one atomic per warp where the whole warp is one
+// node, as at the upper levels).
+__global__ void kdBoundsKernel(KdBuildArrays a, const uint32_t* slots, int level) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  uint32_t node = ~0u;
+  Vec3 p{0, 0, 0};
+  if (i < a.count) {
+    const KdBuildSlot s = kdBuildSlot(a.count, i, level);
+    const uint32_t photon = slots[i];
+    if (s.placed) {
+      if (s.depth == level - 1) {
+        a.treePhotons[s.node] = a.photons[photon];
+        a.nodeToInput[s.node] = photon;
+      }
+    } else {
+      node = s.node;
+      p = a.photons[photon].position;
+    }
+  }
+  const unsigned peers = __match_any_sync(0xffffffffu, node);
+  if (node == ~0u) return;
+  Vec3 lo = p, hi = p;
+  if (peers == 0xffffffffu) {
+    for (int offset = 16; offset > 0; offset >>= 1)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = fminf(lo[k], __shfl_xor_sync(0xffffffffu, lo[k], offset));
+        hi[k] = fmaxf(hi[k], __shfl_xor_sync(0xffffffffu, hi[k], offset));
+      }
+    if ((threadIdx.x & 31u) != 0) return;
+  }
+  for (int k = 0; k < 3; ++k) {
+    atomicMin(a.lower + node * 3 + k, orderedBits(lo[k]));
+    atomicMax(a.upper + node * 3 + k, orderedBits(hi[k]));
+  }
+}
+
+// Slot by slot: the key that sorts each node's photons into its slots by rank along the node's
+// longest axis (the CPU's nth_element order), and keeps placed medians where they are.
+__global__ void kdSplitKeysKernel(KdBuildArrays a, const uint32_t* slots, int level, uint64_t* keys) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= a.count) return;
+  const KdBuildSlot s = kdBuildSlot(a.count, i, level);
+  uint32_t rank = 0;
+  if (!s.placed) {
+    const int axis = kdNodeBounds(a, s.node).longestAxis();
+    if (i == s.begin) a.axes[s.node] = uint8_t(axis);
+    rank = a.ranks[size_t(axis) * a.rankStride + slots[i]];
+  }
+  keys[i] = kdSplitKey(s, i, rank, a.slotBits);
 }
 
 }  // namespace
@@ -88,25 +187,82 @@ void GpuHashGrid::download(std::vector<Photon>& photons, std::vector<uint32_t>& 
   cellStart_.download(cellStart.data(), cellStart.size());
 }
 
-GpuKdTree::Timing GpuKdTree::build(const Photon* photons, uint32_t count, cudaStream_t stream) {
-  using Clock = std::chrono::steady_clock;
-  auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
-  Timing t;
-  auto t0 = Clock::now();
-  host_.resize(count);
-  if (count) PVR_CUDA_CHECK(cudaMemcpyAsync(host_.data(), photons, count * sizeof(Photon), cudaMemcpyDeviceToHost, stream));
-  PVR_CUDA_CHECK(cudaStreamSynchronize(stream));
-  auto t1 = Clock::now();
-  KdTree tree = KdTree::build(host_);
-  auto t2 = Clock::now();
-  photons_.upload(tree.photons().data(), count, "kd-tree photons", stream);
-  KdTreeView hostView = tree.view();
-  axes_.upload(hostView.axes, count, "kd-tree axes", stream);
-  PVR_CUDA_CHECK(cudaStreamSynchronize(stream));  // the host tree dies here
-  auto t3 = Clock::now();
-  t.downloadMs = ms(t0, t1), t.buildMs = ms(t1, t2), t.uploadMs = ms(t2, t3);
+size_t GpuKdTree::memoryBytes() const {
+  return photons_.bytes() + axes_.bytes() + nodeToInput_.bytes() + ranks_.bytes() + order_[0].bytes() +
+         order_[1].bytes() + boundsLower_.bytes() + boundsUpper_.bytes() + keys_[0].bytes() + keys_[1].bytes() +
+         temp_.bytes();
+}
+
+void GpuKdTree::build(const Photon* photons, uint32_t count, cudaStream_t stream) {
+  const size_t n = std::max<size_t>(count, 1);
+  photons_.reserve(n, "kd-tree photons");
+  axes_.reserve(n, "kd-tree axes");
+  nodeToInput_.reserve(n, "kd-tree node order");
+  ranks_.reserve(3 * n, "kd-tree ranks");
+  boundsLower_.reserve(3 * n, "kd-tree node bounds");
+  boundsUpper_.reserve(3 * n, "kd-tree node bounds");
+  for (int b = 0; b < 2; ++b) {
+    order_[b].reserve(n, "kd-tree slots");
+    keys_[b].reserve(n, "kd-tree sort keys");
+  }
+  // The rank sorts use the first half of each key buffer as 32-bit keys.
+  uint32_t* rankKeys[2] = {reinterpret_cast<uint32_t*>(keys_[0].data()), reinterpret_cast<uint32_t*>(keys_[1].data())};
+  cub::DoubleBuffer<uint32_t> rankKeyBuffer(rankKeys[0], rankKeys[1]), rankValues(order_[0].data(), order_[1].data());
+  cub::DoubleBuffer<uint64_t> slotKeys(keys_[0].data(), keys_[1].data());
+  cub::DoubleBuffer<uint32_t> slotValues(order_[0].data(), order_[1].data());
+  const int slotBits = int(bitWidth(uint32_t(n - 1)));
+  size_t rankBytes = 0, slotBytes = 0;
+  PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, rankBytes, rankKeyBuffer, rankValues, int(n), 0, 32, stream));
+  PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, slotBytes, slotKeys, slotValues, int(n), 0,
+                                                 std::max(2 * slotBits, 1), stream));
+  temp_.reserve(std::max(rankBytes, slotBytes), "kd-tree sort scratch");
   view_ = {photons_.data(), axes_.data(), count};
-  return t;
+  if (count == 0) return;
+
+  for (int axis = 0; axis < 3; ++axis) {
+    launch("kd-tree rank keys", kdRankKeysKernel, blocksFor(count, 256), 256, 0, stream, photons, count, axis,
+           rankKeyBuffer.Current(), rankValues.Current());
+    size_t bytes = temp_.capacity();
+    PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, rankKeyBuffer, rankValues, int(count), 0, 32, stream));
+    launch("kd-tree ranks", kdRanksKernel, blocksFor(count, 256), 256, 0, stream, rankValues.Current(), count,
+           ranks_.data() + size_t(axis) * n);
+  }
+  PVR_CUDA_CHECK(cudaMemsetAsync(boundsLower_.data(), 0xff, 3 * n * sizeof(uint32_t), stream));
+  PVR_CUDA_CHECK(cudaMemsetAsync(boundsUpper_.data(), 0, 3 * n * sizeof(uint32_t), stream));
+  launch("kd-tree slots", kdIdentityKernel, blocksFor(count, 256), 256, 0, stream, slotValues.Current(), count);
+  KdBuildArrays a;
+  a.photons = photons;
+  a.count = count;
+  a.ranks = ranks_.data();
+  a.rankStride = uint32_t(n);
+  a.lower = boundsLower_.data();
+  a.upper = boundsUpper_.data();
+  a.axes = axes_.data();
+  a.treePhotons = photons_.data();
+  a.nodeToInput = nodeToInput_.data();
+  a.slotBits = slotBits;
+  const int levels = int(bitWidth(count));
+  for (int level = 0; level <= levels; ++level) {
+    // Places the medians of the level above and bounds the photons still to split at this one.
+    launch("kd-tree bounds", kdBoundsKernel, blocksFor(count, 256), 256, 0, stream, a, slotValues.Current(), level);
+    if (level == levels) break;
+    launch("kd-tree split keys", kdSplitKeysKernel, blocksFor(count, 256), 256, 0, stream, a, slotValues.Current(), level,
+           slotKeys.Current());
+    if (level + 1 == levels) continue;  // the last level's nodes are leaves: one photon each, in place
+    size_t bytes = temp_.capacity();
+    PVR_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, slotKeys, slotValues, int(count), 0,
+                                                   std::max(2 * slotBits, 1), stream));
+  }
+}
+
+void GpuKdTree::download(std::vector<Photon>& photons, std::vector<uint8_t>& axes, std::vector<uint32_t>& nodeToInput) const {
+  const uint32_t n = view_.photonCount;
+  photons.resize(n);
+  axes.resize(n);
+  nodeToInput.resize(n);
+  photons_.download(photons.data(), n);
+  axes_.download(axes.data(), n);
+  nodeToInput_.download(nodeToInput.data(), n);
 }
 
 }  // namespace pvr::cuda

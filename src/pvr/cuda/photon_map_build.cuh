@@ -1,6 +1,6 @@
 #pragma once
 // The map-build stage on the GPU: the hash grid (CUB sort and scan; the CPU builder's cells and
-// order) and the kd-tree baseline (built on the host).
+// order) and the kd-tree baseline (built level by level).
 #include "pvr/cuda/device_scene.cuh"
 
 namespace pvr::cuda {
@@ -26,21 +26,25 @@ class GpuHashGrid {
   int sortedBuffer_ = 0;
 };
 
-// The kd-tree baseline: photons copied to the host, built there (the CPU code), and uploaded.
-// build() reports the three parts so that the comparison with the GPU-built grid is honest.
+// The kd-tree baseline, built on the GPU level by level: the same tree as the CPU build
+// (photon/kd_tree.h). Each photon's rank along each axis, by (coordinate, index), comes from
+// three stable radix sorts; then per level, the bounds of every node's photons (warp-aggregated
+// atomics), its longest axis, and one radix sort of all slots by (node's first slot, rank along
+// the node's axis) put each node's median photon at its split.
 class GpuKdTree {
  public:
-  struct Timing {
-    double downloadMs = 0, buildMs = 0, uploadMs = 0;
-  };
-  Timing build(const Photon* photons, uint32_t count, cudaStream_t stream);
+  void build(const Photon* photons, uint32_t count, cudaStream_t stream);
   KdTreeView view() const { return view_; }
-  size_t memoryBytes() const { return photons_.bytes() + axes_.bytes(); }
+  size_t memoryBytes() const;
+  // Copies the tree back (tests): photons in node order, split axes, node -> input index.
+  void download(std::vector<Photon>& photons, std::vector<uint8_t>& axes, std::vector<uint32_t>& nodeToInput) const;
 
  private:
   DeviceBuffer<Photon> photons_;
   DeviceBuffer<uint8_t> axes_;
-  std::vector<Photon> host_;
+  DeviceBuffer<uint32_t> nodeToInput_, ranks_, order_[2], boundsLower_, boundsUpper_;
+  DeviceBuffer<uint64_t> keys_[2];
+  DeviceBuffer<unsigned char> temp_;
   KdTreeView view_;
 };
 

@@ -1,20 +1,10 @@
 #include "pvr/photon/kd_tree.h"
 
 #include <algorithm>
-#include <bit>
 
 #include "pvr/util/parallel_for.h"
 
 namespace pvr {
-
-uint32_t completeTreeLeftSize(uint32_t n) {
-  if (n <= 1) return 0;
-  uint32_t levels = std::bit_width(n);           // depth of the last level + 1
-  uint32_t aboveLast = (1u << (levels - 1)) - 1;  // nodes in the full levels
-  uint32_t onLast = n - aboveLast;
-  uint32_t leftOnLast = std::min(onLast, 1u << (levels - 2));
-  return (aboveLast - 1) / 2 + leftOnLast;
-}
 
 namespace {
 
@@ -33,7 +23,10 @@ struct Builder {
     int axis = b.longestAxis();
     uint32_t median = begin + completeTreeLeftSize(n);
     std::nth_element(order.begin() + begin, order.begin() + median, order.begin() + end,
-                     [&](uint32_t x, uint32_t y) { return input[x].position[axis] < input[y].position[axis]; });
+                     [&](uint32_t x, uint32_t y) {
+                       const float px = input[x].position[axis], py = input[y].position[axis];
+                       return px < py || (px == py && x < y);  // ties by index: the tree is unique
+                     });
     photons[node] = input[order[median]];
     axes[node] = uint8_t(axis);
     nodeToInput[node] = order[median];
