@@ -30,8 +30,10 @@ __global__ void singleKernel(SceneView scene, SceneIntersector sceneIntersector,
 }
 
 // Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
+// At most 168 registers, so that 6 blocks stay on an SM: unbounded, the kernel took 204 and left
+// 4 (12.5 % occupancy, ncu on Sponza, 2026-12-05), too few warps to hide its memory latency.
 template <StereoRole R>
-__global__ void eyeRaysKernel(SceneView scene, SceneIntersector sceneIntersector, GatherParams params, EyeCamera camera,
+__global__ void __launch_bounds__(kTile* kTile, 6) eyeRaysKernel(SceneView scene, SceneIntersector sceneIntersector, GatherParams params, EyeCamera camera,
                               Eye eye, int sample, StereoReuseView reuse, GatherPointStore points, EyeOutputs out) {
   const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;

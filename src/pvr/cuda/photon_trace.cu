@@ -19,16 +19,40 @@ PVR_HOST_DEVICE inline float floatFromOrdered(int i) {
 
 constexpr int kPhotonBlock = 128;
 
-__global__ void tracePhotonsKernel(SceneView scene, SceneIntersector sceneIntersector, PhotonTraceParams params,
-                                   uint32_t first, uint32_t n, Photon* slots, uint32_t* counts, int* bounds) {
+// Persistent lanes: a lane whose path ended takes the next photon index (a warp fetches for all
+// its idle lanes with one atomic) and starts it at once, so that the warp's lanes keep tracing
+// instead of idling until its longest path ends (Aila and Laine 2009). A photon's random numbers
+// and output slots follow its index, so the result does not depend on which lane traced it.
+__global__ void __launch_bounds__(kPhotonBlock) tracePhotonsKernel(SceneView scene, SceneIntersector sceneIntersector,
+                                                                   PhotonTraceParams params, uint32_t first, uint32_t n,
+                                                                   Photon* slots, uint32_t* counts, int* bounds,
+                                                                   uint32_t* nextPhoton) {
   const SceneIntersector intersector = withSharedStack<kPhotonBlock>(sceneIntersector);
-  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const unsigned lane = threadIdx.x & 31u;
   Bounds3 b;
-  if (i < n) {
+  PhotonPath path;
+  bool tracing = false, drained = false;
+  while (true) {
+    const unsigned idle = __ballot_sync(0xffffffffu, !tracing && !drained);
+    if (idle) {
+      uint32_t base = 0;
+      if (lane == unsigned(__ffs(idle) - 1)) base = atomicAdd(nextPhoton, uint32_t(__popc(idle)));
+      base = __shfl_sync(0xffffffffu, base, __ffs(idle) - 1);
+      if (idle & (1u << lane)) {
+        const uint32_t i = base + uint32_t(__popc(idle & ((1u << lane) - 1u)));
+        if (i < n) path = startPhotonPath(scene, params, first + i), tracing = true;
+        else drained = true;
+      }
+    }
+    if (__all_sync(0xffffffffu, drained)) break;
+    if (!tracing) continue;
+    const uint32_t i = path.index - first;
     Photon* out = slots + size_t(i) * params.maxDepth;
-    int stored = tracePhoton(scene, intersector, params, first + i, out);
-    counts[i] = uint32_t(stored);
-    for (int k = 0; k < stored; ++k) b.extend(out[k].position);
+    if (!advancePhotonPath(scene, intersector, params, path, out)) {
+      counts[i] = uint32_t(path.stored);
+      for (int k = 0; k < path.stored; ++k) b.extend(out[k].position);
+      tracing = false;
+    }
   }
   // Warp-reduce the bounds, then one lane updates the global bounds.
   float v[6] = {b.lower.x, b.lower.y, b.lower.z, b.upper.x, b.upper.y, b.upper.z};
@@ -37,7 +61,7 @@ __global__ void tracePhotonsKernel(SceneView scene, SceneIntersector sceneInters
       float o = __shfl_xor_sync(0xffffffffu, v[a], offset);
       v[a] = a < 3 ? fminf(v[a], o) : fmaxf(v[a], o);
     }
-  if ((threadIdx.x & 31) == 0 && v[0] <= v[3]) {
+  if (lane == 0 && v[0] <= v[3]) {
     for (int a = 0; a < 3; ++a) {
       atomicMin(bounds + a, orderedFromFloat(v[a]));
       atomicMax(bounds + 3 + a, orderedFromFloat(v[3 + a]));
@@ -78,6 +102,12 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
   PVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, tempBytes, counts_.data(), offsets_.data(), chunk + 1, stream));
   temp_.reserve(tempBytes, "photon scan scratch");
 
+  // As many blocks as stay resident: the lanes take photons until none are left.
+  static const unsigned residentBlocks = [] {
+    int perMultiprocessor = 0;
+    PVR_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perMultiprocessor, tracePhotonsKernel, kPhotonBlock, 0));
+    return unsigned(std::max(perMultiprocessor, 1) * multiprocessorCount());
+  }();
   int init[6];
   for (int a = 0; a < 3; ++a) init[a] = orderedFromFloat(INFINITY), init[3 + a] = orderedFromFloat(-INFINITY);
   PVR_CUDA_CHECK(cudaMemcpyAsync(summary_.data(), init, sizeof init, cudaMemcpyHostToDevice, stream));
@@ -85,8 +115,10 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
   for (uint32_t first = params.firstPhoton; first < last; first += chunk) {
     uint32_t n = std::min(chunk, last - first);
     PVR_CUDA_CHECK(cudaMemsetAsync(counts_.data() + n, 0, sizeof(uint32_t), stream));
-    launch("photon trace", tracePhotonsKernel, blocksFor(n, kPhotonBlock), kPhotonBlock, 0, stream, scene.view, scene.intersector, params,
-           first, n, slots_.data(), counts_.data(), summary_.data());
+    PVR_CUDA_CHECK(cudaMemsetAsync(summary_.data() + 6, 0, sizeof(int), stream));  // the next photon to start
+    launch("photon trace", tracePhotonsKernel, std::min(blocksFor(n, kPhotonBlock), residentBlocks), kPhotonBlock, 0, stream,
+           scene.view, scene.intersector, params, first, n, slots_.data(), counts_.data(), summary_.data(),
+           reinterpret_cast<uint32_t*>(summary_.data() + 6));
     size_t bytes = temp_.capacity();
     PVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, counts_.data(), offsets_.data(), n + 1, stream));
     PVR_CUDA_CHECK(cudaMemcpyAsync(hostSummary_, summary_.data(), 6 * sizeof(int), cudaMemcpyDeviceToHost, stream));

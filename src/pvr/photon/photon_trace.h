@@ -94,71 +94,101 @@ PVR_HOST_DEVICE inline Photon emitPhoton(const SceneView& scene, const PhotonTra
   return p;
 }
 
+// A photon's path between surface interactions: what the next interaction needs. The GPU tracer
+// keeps one per lane and starts a new photon as soon as a lane's path ends, so that a warp's lanes
+// do not wait for its longest path.
+struct PhotonPath {
+  Ray ray;
+  Vec3 power;
+  Vec3 offsetNormal;  ///< the side the ray leaves its surface on
+  uint32_t index = 0;  ///< the emitted photon's index: its random numbers
+  int depth = 0;       ///< surface interactions so far
+  int stored = 0;      ///< photons written to its output so far
+};
+
+PVR_HOST_DEVICE inline PhotonPath startPhotonPath(const SceneView& scene, const PhotonTraceParams& params, uint32_t i) {
+  const Photon photon = emitPhoton(scene, params, i);
+  PhotonPath path;
+  path.ray = Ray{photon.position, photon.direction};
+  path.power = photon.power;
+  path.offsetNormal = photon.direction;  // leave the light along its emission side
+  path.index = i;
+  return path;
+}
+
+// The path's next surface interaction: traces its ray, stores a photon at out[path.stored] where
+// one is due, and scatters. False when the path ends (it left the scene, was absorbed, or reached
+// params.maxDepth interactions).
+template <class Intersector>
+PVR_HOST_DEVICE bool advancePhotonPath(const SceneView& scene, const Intersector& intersector,
+                                       const PhotonTraceParams& params, PhotonPath& path, Photon* out) {
+  if (path.depth >= params.maxDepth) return false;
+  const int depth = path.depth++;
+  Ray& ray = path.ray;
+  ray.origin = ray.origin + path.offsetNormal * scene.rayEpsilon();
+  Hit hit;
+  if (!intersector.intersect(ray, INFINITY, hit)) return false;
+  SurfacePoint sp = scene.surfacePoint(hit);
+  const Material& m = scene.materials[sp.materialId];
+  CounterRng rng(params.seed, path.index, uint32_t(depth) + 1);
+  Vec3 dir = ray.dir;
+  if (m.type == MaterialType::Microfacet) {
+    if (depth > 0 || params.storeDirect) {
+      Photon& s = out[path.stored++];
+      s.position = sp.position;
+      s.power = path.power;
+      s.direction = dir;
+    }
+    // Three statements: the order of evaluation of arguments differs between g++ and nvcc.
+    float uLobe = rng.uniform();
+    float u1 = rng.uniform();
+    float u2 = rng.uniform();
+    BsdfSample bs = sampleBsdf(scene.bsdfAt(m, hit, sp, -dir), -dir, uLobe, u1, u2);
+    if (!bs.valid()) return false;
+    float survive = fminf(1.0f, maxComponent(bs.weight));
+    if (!(rng.uniform() < survive)) return false;
+    path.power *= bs.weight * (1.0f / survive);
+    ray.dir = bs.wi;
+    path.offsetNormal = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
+  } else if (m.type == MaterialType::Diffuse) {
+    Vec3 nFacing = dot(dir, sp.geometricNormal) < 0.0f ? sp.geometricNormal : -sp.geometricNormal;
+    Vec3 nShade = dot(sp.shadingNormal, nFacing) < 0.0f ? -sp.shadingNormal : sp.shadingNormal;
+    bool direct = depth == 0;  // L D: shaded by shadow rays unless the map shades alone
+    if (!direct || params.storeDirect) {
+      Photon& s = out[path.stored++];
+      s.position = sp.position;
+      s.power = path.power;
+      s.direction = dir;
+    }
+    Vec3 albedo = scene.albedoAt(m, hit.primId, hit.u, hit.v);
+    float survive = fminf(1.0f, maxComponent(albedo));
+    if (!(rng.uniform() < survive)) return false;
+    path.power *= albedo * (1.0f / survive);
+    // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
+    float uTheta = rng.uniform();
+    float uPhi = rng.uniform();
+    Vec3 local = sampleCosineHemisphere(uTheta, uPhi);
+    ray.dir = Frame::fromNormal(nShade).toWorld(local);
+    if (dot(ray.dir, nFacing) <= 0.0f) return false;  // shading normal sent it below the surface
+    path.offsetNormal = nFacing;
+  } else {
+    Vec3 throughput{1, 1, 1};
+    ray.dir = scatterSpecular(m, dir, sp.shadingNormal, rng.uniform(), throughput);
+    path.power *= throughput;
+    path.offsetNormal = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
+  }
+  ray.origin = sp.position;
+  return true;
+}
+
 // Traces photon i; writes at most params.maxDepth photons to `out` and returns how many.
 template <class Intersector>
 PVR_HOST_DEVICE int tracePhoton(const SceneView& scene, const Intersector& intersector,
                                 const PhotonTraceParams& params, uint32_t i, Photon* out) {
-  Photon photon = emitPhoton(scene, params, i);
-  Ray ray{photon.position, photon.direction};
-  Vec3 offsetNormal = photon.direction;  // leave the light along its emission side
-  int stored = 0;
-  float eps = scene.rayEpsilon();
-  for (int depth = 0; depth < params.maxDepth; ++depth) {
-    ray.origin = ray.origin + offsetNormal * eps;
-    Hit hit;
-    if (!intersector.intersect(ray, INFINITY, hit)) break;
-    SurfacePoint sp = scene.surfacePoint(hit);
-    const Material& m = scene.materials[sp.materialId];
-    CounterRng rng(params.seed, i, uint32_t(depth) + 1);
-    Vec3 dir = ray.dir;
-    if (m.type == MaterialType::Microfacet) {
-      if (depth > 0 || params.storeDirect) {
-        Photon& s = out[stored++];
-        s.position = sp.position;
-        s.power = photon.power;
-        s.direction = dir;
-      }
-      // Three statements: the order of evaluation of arguments differs between g++ and nvcc.
-      float uLobe = rng.uniform();
-      float u1 = rng.uniform();
-      float u2 = rng.uniform();
-      BsdfSample bs = sampleBsdf(scene.bsdfAt(m, hit, sp, -dir), -dir, uLobe, u1, u2);
-      if (!bs.valid()) break;
-      float survive = fminf(1.0f, maxComponent(bs.weight));
-      if (!(rng.uniform() < survive)) break;
-      photon.power *= bs.weight * (1.0f / survive);
-      ray.dir = bs.wi;
-      offsetNormal = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
-    } else if (m.type == MaterialType::Diffuse) {
-      Vec3 nFacing = dot(dir, sp.geometricNormal) < 0.0f ? sp.geometricNormal : -sp.geometricNormal;
-      Vec3 nShade = dot(sp.shadingNormal, nFacing) < 0.0f ? -sp.shadingNormal : sp.shadingNormal;
-      bool direct = depth == 0;  // L D: shaded by shadow rays unless the map shades alone
-      if (!direct || params.storeDirect) {
-        Photon& s = out[stored++];
-        s.position = sp.position;
-        s.power = photon.power;
-        s.direction = dir;
-      }
-      Vec3 albedo = scene.albedoAt(m, hit.primId, hit.u, hit.v);
-      float survive = fminf(1.0f, maxComponent(albedo));
-      if (!(rng.uniform() < survive)) break;
-      photon.power *= albedo * (1.0f / survive);
-      // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
-      float uTheta = rng.uniform();
-      float uPhi = rng.uniform();
-      Vec3 local = sampleCosineHemisphere(uTheta, uPhi);
-      ray.dir = Frame::fromNormal(nShade).toWorld(local);
-      if (dot(ray.dir, nFacing) <= 0.0f) break;  // shading normal sent it below the surface
-      offsetNormal = nFacing;
-    } else {
-      Vec3 throughput{1, 1, 1};
-      ray.dir = scatterSpecular(m, dir, sp.shadingNormal, rng.uniform(), throughput);
-      photon.power *= throughput;
-      offsetNormal = dot(ray.dir, sp.geometricNormal) > 0.0f ? sp.geometricNormal : -sp.geometricNormal;
-    }
-    ray.origin = sp.position;
+  PhotonPath path = startPhotonPath(scene, params, i);
+  while (advancePhotonPath(scene, intersector, params, path, out)) {
   }
-  return stored;
+  return path.stored;
 }
 
 }  // namespace pvr
