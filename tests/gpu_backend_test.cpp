@@ -94,14 +94,19 @@ TEST(GpuBackend, StoredPhotonsMatchTheCpu) {
     }
 }
 
+// 256x256 photons traced in the Cornell box, direct ones stored: the maps' test input.
+std::vector<Photon> cornellPhotons(CudaFrameBackend& gpu) {
+  PhotonTraceParams params;
+  params.photonCount = 256 * 256;
+  params.storeDirect = true;
+  return gpu.tracePhotonsToHost(params);
+}
+
 TEST(GpuBackend, HashGridMatchesTheCpuBuildExactly) {
   PVR_REQUIRE_GPU();
   Scene scene = builtinScene("cornell");
   CudaFrameBackend gpu(scene);
-  PhotonTraceParams params;
-  params.photonCount = 256 * 256;
-  params.storeDirect = true;
-  std::vector<Photon> photons = gpu.tracePhotonsToHost(params);
+  std::vector<Photon> photons = cornellPhotons(gpu);
   for (float radius : {0.02f, 0.05f, 0.2f}) {
     GpuHashGridCopy copy;
     gpu.buildHashGrid(photons, radius, 1, &copy);
@@ -117,10 +122,7 @@ TEST(GpuBackend, KdTreeMatchesTheCpuBuildExactly) {
   PVR_REQUIRE_GPU();
   Scene scene = builtinScene("cornell");
   CudaFrameBackend gpu(scene);
-  PhotonTraceParams params;
-  params.photonCount = 256 * 256;
-  params.storeDirect = true;
-  std::vector<Photon> traced = gpu.tracePhotonsToHost(params);
+  std::vector<Photon> traced = cornellPhotons(gpu);
   // Every size from one photon to a few levels, then the traced set, which has coordinates that
   // tie (photons on the walls share a coordinate): ties are broken by index on both sides.
   std::vector<size_t> sizes;

@@ -357,6 +357,23 @@ std::vector<Photon> CudaFrameBackend::tracePhotonsToHost(const PhotonTraceParams
   return photons;
 }
 
+namespace {
+// The median of `repeats` timed runs of `build` (CUDA events), after one untimed run.
+template <class Build>
+double medianBuildMs(cuda::EventTimer& timer, cudaStream_t stream, int repeats, const Build& build) {
+  std::vector<double> times;
+  for (int r = -1; r < std::max(repeats, 1); ++r) {
+    timer.start(stream);
+    build();
+    timer.stop(stream);
+    const double ms = timer.ms();
+    if (r >= 0) times.push_back(ms);
+  }
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+}  // namespace
+
 double CudaFrameBackend::buildHashGrid(const std::vector<Photon>& photons, float radius, int repeats,
                                        GpuHashGridCopy* copy) {
   Impl& m = *impl_;
@@ -364,36 +381,23 @@ double CudaFrameBackend::buildHashGrid(const std::vector<Photon>& photons, float
   input.upload(photons.data(), photons.size(), "benchmark photons", m.stream);
   Bounds3 bounds;  // what the tracer's kernel reduces on the device
   for (const Photon& p : photons) bounds.extend(p.position);
-  std::vector<double> times;
-  for (int r = -1; r < std::max(repeats, 1); ++r) {
-    m.benchTimer.start(m.stream);
+  const double ms = medianBuildMs(m.benchTimer, m.stream, repeats, [&] {
     m.grid.build(input.data(), uint32_t(photons.size()), bounds, radius, m.stream);
-    m.benchTimer.stop(m.stream);
-    double ms = m.benchTimer.ms();
-    if (r >= 0) times.push_back(ms);
-  }
+  });
   if (copy) m.grid.download(copy->photons, copy->cellStart, copy->sortedToInput);
   m.gridView = m.grid.view();
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
+  return ms;
 }
 
 double CudaFrameBackend::buildKdTree(const std::vector<Photon>& photons, int repeats, GpuKdTreeCopy* copy) {
   Impl& m = *impl_;
   cuda::DeviceBuffer<Photon> input;
   input.upload(photons.data(), photons.size(), "benchmark photons", m.stream);
-  std::vector<double> times;
-  for (int r = -1; r < std::max(repeats, 1); ++r) {
-    m.benchTimer.start(m.stream);
-    m.tree.build(input.data(), uint32_t(photons.size()), m.stream);
-    m.benchTimer.stop(m.stream);
-    double ms = m.benchTimer.ms();
-    if (r >= 0) times.push_back(ms);
-  }
+  const double ms = medianBuildMs(m.benchTimer, m.stream, repeats,
+                                  [&] { m.tree.build(input.data(), uint32_t(photons.size()), m.stream); });
   if (copy) m.tree.download(copy->photons, copy->axes, copy->nodeToInput);
   m.treeView = m.tree.view();
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
+  return ms;
 }
 
 FrameRenderer makeCudaFrameRenderer(const Scene& scene) {
