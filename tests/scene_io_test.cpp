@@ -91,6 +91,7 @@ TEST(SceneErrors, EachBadInputThrowsAClearError) {
       {kData + "/malformed.gltf", "cannot read"},
       {kData + "/primitive_without_positions.gltf", "mesh 0 primitive 0 has no POSITION attribute"},
       {kData + "/invalid_utf8.gltf", "not valid JSON (at byte"},
+      {kData + "/image_mime_type_without_slash.gltf", "image 0 has a mimeType that is not a MIME type"},
       {kData + "/no_light.json", "has no light"},
       {"cornel", "no such file or built-in scene"},
   };

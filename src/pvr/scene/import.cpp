@@ -384,6 +384,15 @@ void checkGltfRanges(const GltfFile& file, const std::string& path) {
         (count - 1) * stride + element > viewBytes[view] - offset)
       malformed("accessor " + std::to_string(a) + " reads past the end of bufferView " + std::to_string(view));
   }
+  // assimp 5.2 takes an embedded image's format from the part of its mimeType after '/', and reads
+  // address 1 when there is no '/' (a fuzzer finding). Every glTF image type has one.
+  const json images = array("images");
+  for (size_t i = 0; i < images.size(); ++i) {
+    if (!images[i].is_object() || !images[i].contains("mimeType")) continue;
+    const json& mime = images[i]["mimeType"];
+    if (!mime.is_string() || mime.get<std::string>().find('/') == std::string::npos)
+      malformed("image " + std::to_string(i) + " has a mimeType that is not a MIME type (image/png, image/jpeg)");
+  }
   // assimp 5.2 sizes a primitive without positions from a vertex count of zero, and a strip or
   // fan then asks for ~64 GB. The spec lets viewers skip such primitives; we refuse the file.
   const json meshes = array("meshes");
