@@ -913,25 +913,36 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
       FrameRenderer* renderer;
       StereoMode stereo;
       int shadowRays;  ///< to the punctual lights per gather point (0: one per light)
+      RaySchedule schedule = RaySchedule::Auto;
     };
     // The textured cells choose one punctual light per shadow ray; "every light" shows what one
-    // exact ray per light costs, the untextured cell what texture sampling costs.
+    // exact ray per light costs, the untextured cell what texture sampling costs, and the last
+    // what the GPU's first-hit pre-pass saves (the camera rays traced by the eye kernel instead:
+    // the same image up to rounding, checked), and what deferring the shadow rays to a kernel of
+    // their own saves (likewise); "gather" takes the schedule RaySchedule::Auto picks.
     const Cell allCells[] = {{"separate", renderer.get(), StereoMode::Separate, 1},
                              {"gather", renderer.get(), StereoMode::Gather, 1},
                              {"gather, a ray to every light", renderer.get(), StereoMode::Gather, 0},
-                             {"gather, no colour textures", plainRenderer.get(), StereoMode::Gather, 1}};
+                             {"gather, no colour textures", plainRenderer.get(), StereoMode::Gather, 1},
+                             {"gather, all rays in the eye kernel", renderer.get(), StereoMode::Gather, 1, RaySchedule::InKernel},
+                             {"gather, first hits apart", renderer.get(), StereoMode::Gather, 1, RaySchedule::FirstHits},
+                             {"gather, first hits and shadow rays apart", renderer.get(), StereoMode::Gather, 1, RaySchedule::Deferred}};
     std::vector<Cell> cells(allCells, allCells + 2);
     if (scene.punctualLights().size() > 1) cells.push_back(allCells[2]);
     if (scene.textureCount() > 0) cells.push_back(allCells[3]);  // no textures: nothing to leave out
+    if (kind == BackendKind::Cuda)  // the CPU traces in place
+      for (int k = 4; k < 7; ++k) cells.push_back(allCells[k]);
+    FrameResult gatherFrame;
     const FrameRays rays = countFrameRays(scene, rig, o);
     double gatherEyePassMs = 0, untexturedEyePassMs = 0;
     for (size_t c = 0; c < cells.size(); ++c) {
       RenderOptions co = o;
       co.stereo = cells[c].stereo;
       co.gather.punctualShadowRays = cells[c].shadowRays;
+      co.raySchedule = cells[c].schedule;
       CellResult r = timeCell(*cells[c].renderer, rig, co, args.warmup, args.frames);
       const bool untextured = cells[c].renderer == plainRenderer.get();
-      if (c == 1) gatherEyePassMs = r.stages.eyePass.mean;
+      if (c == 1) gatherEyePassMs = r.stages.eyePass.mean, gatherFrame = r.last;
       if (untextured) untexturedEyePassMs = r.stages.eyePass.mean;
       double error[2] = {compareImages(converged[0], r.last.eyes[0].image).relativeMad,
                          compareImages(converged[1], r.last.eyes[1].image).relativeMad};
@@ -940,6 +951,12 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
       // Textured frames must converge towards the reference (a broken path shows here); the
       // untextured one must differ from it (textures do something).
       bool ok = !untextured ? error[0] < 0.5 && error[1] < 0.5 : error[0] > 0.01;
+      double scheduleRelMse[2] = {0, 0};  // against the gather cell: where rays are traced changes only rounding
+      if (cells[c].schedule != RaySchedule::Auto)
+        for (int e = 0; e < 2; ++e) {
+          scheduleRelMse[e] = compareToReference(r.last.eyes[e].image, gatherFrame.eyes[e].image).relMse;
+          ok = ok && scheduleRelMse[e] < 1e-8 && *r.last.eyes[e].firstPrim == *gatherFrame.eyes[e].firstPrim;
+        }
       failures += ok ? 0 : 1;
       std::printf("| %s | %dx%d | 512x512 | %g (%.2f %%) | %s | %s | %s | %s | %s | %s | %.2f | %.2f | %.3f / %.3f | "
                   "%.3f / %.3f | %.3f / %.3f | %s |\n",
@@ -948,11 +965,22 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
                   meanP99(r.stages.build, 2).c_str(), meanP99(r.stages.eye[0], 2).c_str(), meanP99(r.stages.eye[1], 2).c_str(),
                   r.stages.rays.mean, r.stages.density.mean, ref[0].relMse, ref[1].relMse, ref[0].ssim, ref[1].ssim,
                   error[0], error[1], ok ? "ok" : "MISMATCH");
+      if (c == 1 && kind == BackendKind::Cuda) {
+        const int queries = shadowQueriesPerPoint(scene.view(), cells[c].shadowRays);
+        std::printf("| %s | gather's ray schedule (auto): %s for the left eye, %s for the right (%d shadow queries per "
+                    "point) |\n",
+                    scene.name.c_str(), rayScheduleName(eyeRayScheduleFor(queries, false)),
+                    rayScheduleName(eyeRayScheduleFor(queries, true)), queries);
+      }
+      if (cells[c].schedule != RaySchedule::Auto)
+        std::printf("| %s | %s: relMSE against the gather cell's image %.2g / %.2g (rounding), the same first hits |\n",
+                    scene.name.c_str(), cells[c].name, scheduleRelMse[0], scheduleRelMse[1]);
       nlohmann::json cell = r.latencyJson();
       cell.update({{"suite", "scenes"}, {"scene", scene.name}, {"variant", cells[c].name}, {"backend", renderer->name()},
                    {"device", renderer->deviceName()}, {"eye_size", {rig.width, rig.height}}, {"photons", 512 * 512},
                    {"radius", radius}, {"radius_of_diagonal", radius / diagonal},
-                   {"punctual_shadow_rays", cells[c].shadowRays}, {"punctual_lights", scene.punctualLights().size()},
+                   {"punctual_shadow_rays", cells[c].shadowRays}, {"ray_schedule", rayScheduleName(cells[c].schedule)},
+                   {"rel_mse_vs_gather_cell", {scheduleRelMse[0], scheduleRelMse[1]}}, {"punctual_lights", scene.punctualLights().size()},
                    {"triangles", scene.triangleCount()}, {"textures", scene.textureCount()},
                    {"rmad_vs_reference", {error[0], error[1]}}, {"rel_mse_vs_reference", {ref[0].relMse, ref[1].relMse}},
                    {"ssim_vs_reference", {ref[0].ssim, ref[1].ssim}}, {"psnr_vs_reference", {ref[0].psnr, ref[1].psnr}},

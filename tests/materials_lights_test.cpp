@@ -9,6 +9,7 @@
 
 #include "pvr/accel/bvh_traversal.h"
 #include "pvr/cpu/cpu_backend.h"
+#include "pvr/photon/deferred_shadows.h"
 #include "pvr/photon/gather.h"
 #include "pvr/photon/hash_grid.h"
 #include "pvr/scene/scene.h"
@@ -286,6 +287,96 @@ TEST(Lights, OneShadowRayAmongManyLightsIsExactWhenVisibleAndUnbiasedWhenNot) {
     if (rays == 1) {
       EXPECT_GT(sunOnly, paths / 10);  // the rays that chose the hidden lamp
     }
+  }
+}
+
+// Shadow rays deferred to a kernel of their own (photon/deferred_shadows.h): the gathering code run
+// once to record its shadow queries, the queries traced apart, and the code run again with those
+// answers gives every pixel bit for bit as tracing in place, with every kind of light (sun, sky,
+// point lights chosen among, an area light), an occluder, a mirror and glass on the paths, one
+// ray per light (6 queries: the two past kMaxDeferredShadows traced in place) and two samples.
+TEST(Lights, DeferredShadowQueriesAnswerAsTracedInPlace) {
+  Scene scene;
+  Material white, mirror, glass, lamp;
+  white.albedo = {0.8f, 0.7f, 0.6f};
+  mirror.type = MaterialType::Mirror;
+  glass.type = MaterialType::Glass;
+  lamp.emission = {4, 4, 4};
+  const uint32_t whiteId = scene.addMaterial(white, "floor"), mirrorId = scene.addMaterial(mirror, "mirror");
+  const uint32_t glassId = scene.addMaterial(glass, "glass"), lampId = scene.addMaterial(lamp, "lamp");
+  scene.addMesh("floor", {{-4, 0, -4}, {4, 0, -4}, {4, 0, 4}, {-4, 0, 4}}, {}, {0, 2, 1, 0, 3, 2}, whiteId);
+  scene.addMesh("roof", {{-0.6f, 1, -0.6f}, {0.6f, 1, -0.6f}, {0.6f, 1, 0.6f}, {-0.6f, 1, 0.6f}}, {}, {0, 1, 2, 0, 2, 3}, whiteId);
+  scene.addMesh("mirror", {{1.5f, 0, -1}, {1.5f, 0, 1}, {1.5f, 1.2f, 1}, {1.5f, 1.2f, -1}}, {}, {0, 1, 2, 0, 2, 3}, mirrorId);
+  scene.addMesh("glass", {{-1.5f, 0, -1}, {-1.5f, 1.2f, -1}, {-1.5f, 1.2f, 1}, {-1.5f, 0, 1}}, {}, {0, 1, 2, 0, 2, 3}, glassId);
+  scene.addMesh("panel", {{-0.3f, 2.5f, -0.3f}, {0.3f, 2.5f, -0.3f}, {0.3f, 2.5f, 0.3f}, {-0.3f, 2.5f, 0.3f}}, {},
+                {0, 1, 2, 0, 2, 3}, lampId);
+  PunctualLight sun;
+  sun.kind = PunctualKind::Directional;
+  sun.direction = normalize(Vec3(-0.3f, -1.0f, 0.2f));
+  sun.intensity = {1, 1.2f, 1.5f};
+  scene.addPunctualLight(sun, "sun");
+  for (float x : {-1.0f, 0.0f, 1.0f}) {
+    PunctualLight point;
+    point.position = {x, 0.6f, 0.8f};
+    point.intensity = {2, 2, 2};
+    scene.addPunctualLight(point, "point");
+  }
+  SkyLight sky;
+  sky.radiance = {0.2f, 0.3f, 0.4f};
+  scene.setSky(sky);
+  scene.rig.head.position = {0, 2.2f, 3.0f};
+  scene.rig.head.orientation = Quat::fromAxisAngle({1, 0, 0}, -0.5f);
+  scene.finalize();
+  CpuBackend backend(scene);
+  const EmbreeIntersector& embree = backend.intersector();
+  const SceneView view = scene.view();
+  PhotonTraceParams tp;
+  tp.photonCount = 1u << 14;
+  const HashGrid grid = HashGrid::build(backend.tracePhotons(tp), 0.1f);
+  StereoRig rig = scene.rig;
+  rig.width = 40, rig.height = 36;
+  const EyeCamera camera = rig.eye(Eye::Left);
+  const size_t pixels = size_t(camera.width) * camera.height;
+  std::vector<ShadowQuery> queries(kMaxDeferredShadows * pixels);
+  std::vector<uint8_t> asked(pixels), blocked(kMaxDeferredShadows * pixels);
+  const DeferredShadowsView shadows{queries.data(), asked.data(), blocked.data(), pixels};
+  for (int shadowRays : {1, 0}) {
+    GatherParams params;
+    params.density.radius = 0.1f;
+    params.punctualShadowRays = shadowRays;
+    params.samplesPerPixel = 2;
+    size_t differing = 0, overflowing = 0, answered = 0, someBlocked = 0;
+    int mostAsked = 0;
+    const int perPoint = shadowQueriesPerPoint(view, shadowRays);
+    EXPECT_EQ(perPoint, shadowRays == 1 ? 4 : 6);  // sun, one or three points, panel, sky
+    for (int y = 0; y < camera.height; ++y)
+      for (int x = 0; x < camera.width; ++x) {
+        const size_t i = size_t(y) * camera.width + x;
+        for (int s = 0; s < params.samplesPerPixel; ++s) {
+          PixelSample discarded;
+          const RecordedShadows<const EmbreeIntersector&> recorder{embree, queries.data() + i, pixels};
+          pixelGatherPoint(view, recorder, params, camera, Eye::Left, x, y, s, StereoReuseView(), discarded);
+          asked[i] = uint8_t(recorder.recorded());
+          overflowing += recorder.asked > kMaxDeferredShadows;
+          mostAsked = std::max(mostAsked, recorder.asked);
+          for (int k = 0; k < kMaxDeferredShadows; ++k) answerShadowQuery(embree, shadows, k, i);
+          for (int k = 0; k < asked[i]; ++k) answered += 1, someBlocked += blocked[k * pixels + i];
+          PixelSample inPlace, replayed;
+          const GatherPoint a = pixelGatherPoint(view, embree, params, camera, Eye::Left, x, y, s, StereoReuseView(), inPlace);
+          const ReplayedShadows<const EmbreeIntersector&> replay{embree, blocked.data() + i, pixels};
+          const GatherPoint b = pixelGatherPoint(view, replay, params, camera, Eye::Left, x, y, s, StereoReuseView(), replayed);
+          EXPECT_EQ(replay.asked, recorder.asked);
+          const Vec3 la = finishGather(grid.view(), a, params.density), lb = finishGather(grid.view(), b, params.density);
+          differing += !(a.radiance == b.radiance && a.weight == b.weight && la == lb && inPlace.firstPrim == replayed.firstPrim);
+        }
+      }
+    EXPECT_EQ(differing, 0u) << "shadow rays per gather point " << shadowRays;
+    EXPECT_EQ(mostAsked, perPoint);  // a Lambertian point facing every light asks them all, no more
+    EXPECT_GT(answered, pixels);
+    EXPECT_GT(someBlocked, answered / 20);  // the roof, the walls and the floor's far side block some
+    EXPECT_LT(someBlocked, answered);
+    if (shadowRays == 0) EXPECT_GT(overflowing, pixels / 4);  // past kMaxDeferredShadows: traced in place
+    else EXPECT_EQ(overflowing, 0u);
   }
 }
 

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <random>
@@ -266,6 +268,27 @@ TEST(PhotonMaps, KdTreeIsACompleteBalancedSplitTree) {
 
 // The tree is unique: with coordinates that tie (photons on a lattice), the build equals a plain
 // recursive one that sorts every subtree by (coordinate, index), as the GPU build orders them.
+// The GPU keeps the photons' bounds with integer atomics on orderedBits and ranks coordinates by
+// radix-sorting them: the integers must order exactly as the floats do (-0 and +0 alike, as
+// for the CPU's <) and give the float back.
+TEST(PhotonMaps, OrderedBitsSortAsTheFloatsAndRoundTrip) {
+  std::vector<float> values = {-INFINITY, -FLT_MAX, -1.0f, -FLT_MIN, -1e-45f, -0.0f, 0.0f, 1e-45f, FLT_MIN, 1.0f, FLT_MAX, INFINITY};
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<uint32_t> bits;
+  while (values.size() < 3000) {
+    const float f = floatFromBits(bits(rng));
+    if (!std::isnan(f)) values.push_back(f);
+  }
+  for (float a : values) {
+    const float back = fromOrderedBits(orderedBits(a));
+    EXPECT_EQ(floatBits(back), floatBits(a == 0.0f ? 0.0f : a)) << a;
+    for (float b : values) {
+      ASSERT_EQ(a < b, orderedBits(a) < orderedBits(b)) << a << " " << b;
+      ASSERT_EQ(a == b, orderedBits(a) == orderedBits(b)) << a << " " << b;
+    }
+  }
+}
+
 TEST(PhotonMaps, KdTreeBreaksTiesByIndex) {
   std::mt19937 rng(5);
   std::uniform_int_distribution<int> lattice(0, 3);

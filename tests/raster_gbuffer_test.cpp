@@ -11,6 +11,7 @@
 #include <memory>
 #include <random>
 
+#include "pvr/cpu/cpu_backend.h"
 #include "pvr/cpu/embree_intersector.h"
 #include "pvr/image/image_compare.h"
 #include "pvr/raster/gbuffer_raster.h"
@@ -232,6 +233,58 @@ TEST(RasterGBuffer, CutOutTexelsAreSeenThroughAsByRays) {
       }
     EXPECT_GT(throughCutOut, 100);
     EXPECT_GT(onQuad, 100);
+  }
+}
+
+
+// The GPU's first-hit pre-pass (PrimaryHitsView::traced) hands the eye pass the hits it would have
+// traced itself: shading from them is bit for bit shading in place, for centred and jittered first
+// samples, through mirrors and glass (cornell-caustics) and through cut-out texels.
+TEST(PrimaryHits, PreTracedFirstHitsShadeExactlyAsTracingInPlace) {
+  Scene cutOut = test::cutOutQuadOverFloor();
+  cutOut.rig.head.position = {0, 2, 0};
+  cutOut.rig.head.orientation = Quat::fromAxisAngle({1, 0, 0}, -0.5f * kPi);  // looking down
+  for (const Scene& scene : {loadScene("cornell-caustics"), cutOut}) {
+    SCOPED_TRACE(scene.name);
+    CpuBackend backend(scene);
+    StereoRig rig = scene.rig;
+    rig.width = 56, rig.height = 48;
+    PhotonTraceParams tp;
+    tp.photonCount = 1u << 14;
+    const float radius = 0.06f;
+    const HashGrid grid = HashGrid::build(backend.tracePhotons(tp), radius);
+    const EyeCamera camera = rig.eye(Eye::Right);
+    const size_t pixels = size_t(camera.width) * camera.height;
+    for (bool jitter : {false, true}) {
+      GatherParams params;
+      params.density.radius = radius;
+      params.jitterFirstSample = jitter;
+      params.samplesPerPixel = 2;
+      std::vector<Hit> hits(pixels);
+      size_t valid = 0;
+      for (int y = 0; y < camera.height; ++y)
+        for (int x = 0; x < camera.width; ++x) {
+          const Hit h = pixelFirstHit(backend.intersector(), params, camera, Eye::Right, x, y);
+          hits[size_t(y) * camera.width + x] = h;
+          valid += h.valid();
+        }
+      EXPECT_GT(valid, pixels / 2);
+      GatherParams fromHits = params;
+      fromHits.primary.traced = hits.data();
+      fromHits.primary.width = camera.width;
+      std::vector<PixelSample> a(pixels), b(pixels);
+      backend.renderEye(camera, Eye::Right, params, grid.view(), a.data());
+      backend.renderEye(camera, Eye::Right, fromHits, grid.view(), b.data());
+      size_t differing = 0, lit = 0;
+      for (size_t i = 0; i < pixels; ++i) {
+        const Vec3 &p = a[i].radiance, &q = b[i].radiance;
+        differing += p.x != q.x || p.y != q.y || p.z != q.z || a[i].firstPrim != b[i].firstPrim ||
+                     a[i].inverseDepth != b[i].inverseDepth;
+        lit += p.x > 0.0f;
+      }
+      EXPECT_EQ(differing, 0u) << "jittered first sample: " << jitter;
+      EXPECT_GT(lit, pixels / 2);
+    }
   }
 }
 

@@ -225,6 +225,9 @@ void CudaFrameBackend::renderEye(const EyePass& pass) {
   m.frame.cached = m.frame.cached || (pass.density == DensityScheme::SurfaceCache && !pass.foveated());
   if (faultInjected(Fault::GpuKernelFault)) cuda::launchInjectedFault(m.stream);
   EyePass p = pass;
+  if (p.raySchedule == RaySchedule::Auto)
+    p.raySchedule = eyeRayScheduleFor(shadowQueriesPerPoint(m.scene.view(), p.gather.punctualShadowRays),
+                                      p.role == StereoRole::Reuser);
   if (pass.rasterPrimary) {
     if (!m.frame.rasterised) throw Error("frame pipeline: an eye pass reads rasterised first hits this frame did not make");
     p.gather.primary = m.primaryHits(pass.eye);

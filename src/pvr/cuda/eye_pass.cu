@@ -5,6 +5,7 @@
 #include "pvr/cuda/density.cuh"
 #include "pvr/cuda/eye_kernels.cuh"
 #include "pvr/cuda/surface_cache.cuh"
+#include "pvr/photon/deferred_shadows.h"
 
 namespace pvr::cuda {
 namespace {
@@ -29,25 +30,72 @@ __global__ void singleKernel(SceneView scene, SceneIntersector sceneIntersector,
   }
 }
 
+// The intersector the eye-rays kernel shades through: shadow queries answered from the deferred
+// shadow kernel's results (Deferred), or traced in place.
+template <bool Deferred>
+__device__ inline auto shadingIntersector(const SceneIntersector& intersector, const DeferredShadowsView& shadows,
+                                          size_t pixel) {
+  if constexpr (Deferred) return ReplayedShadows<SceneIntersector>{intersector, shadows.blocked + pixel, shadows.pixels};
+  else return intersector;
+}
+
 // Hybrid, first kernel: eye rays to their gather points (a reused pixel's carries its colour).
 // At most 168 registers, so that 6 blocks stay on an SM: unbounded, the kernel took 204 and left
 // 4 (12.5 % occupancy, ncu on Sponza, 2026-12-05), too few warps to hide its memory latency.
-template <StereoRole R>
+template <StereoRole R, bool Deferred>
 __global__ void __launch_bounds__(kTile* kTile, 6) eyeRaysKernel(SceneView scene, SceneIntersector sceneIntersector, GatherParams params, EyeCamera camera,
-                              Eye eye, int sample, StereoReuseView reuse, GatherPointStore points, EyeOutputs out) {
+                              Eye eye, int sample, StereoReuseView reuse, GatherPointStore points, EyeOutputs out,
+                              DeferredShadowsView shadows) {
   const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   int x, y;
   if (!tilePixel(camera.width, camera.height, x, y)) return;
   size_t pixel = size_t(y) * camera.width + x;
   PixelSample state;
   if (R == StereoRole::Reuser && sample > 0) state.reusedFrom = out.reusedFrom[pixel];  // sample 0 decided
-  const GatherPoint point = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, reuseFor<R>(reuse),
-                                            state, surfaceFor<R>(out, pixel));
+  const GatherPoint point = pixelGatherPoint(scene, shadingIntersector<Deferred>(intersector, shadows, pixel), params, camera,
+                                            eye, x, y, sample, reuseFor<R>(reuse), state, surfaceFor<R>(out, pixel));
   points.store(pixel, point);
   recordGuide(out, pixel, point, sample, params.samplesPerPixel);
   if (sample == 0) recordPixel(out, pixel, state);
 }
 
+// Deferred shadows, first run (photon/deferred_shadows.h): the eye-rays kernel's gathering code,
+// its shading thrown away, to record the shadow queries it asks.
+template <StereoRole R>
+__global__ void __launch_bounds__(kTile* kTile, 6) recordShadowsKernel(SceneView scene, SceneIntersector sceneIntersector,
+                                                                      GatherParams params, EyeCamera camera, Eye eye,
+                                                                      int sample, StereoReuseView reuse, EyeOutputs out,
+                                                                      DeferredShadowsView shadows) {
+  const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  const size_t pixel = size_t(y) * camera.width + x;
+  PixelSample state;
+  if (R == StereoRole::Reuser && sample > 0) state.reusedFrom = out.reusedFrom[pixel];
+  const RecordedShadows<SceneIntersector> recorder{intersector, shadows.queries + pixel, shadows.pixels};
+  pixelGatherPoint(scene, recorder, params, camera, eye, x, y, sample, reuseFor<R>(reuse), state);
+  shadows.asked[pixel] = uint8_t(recorder.recorded());
+}
+
+// Deferred shadows: query blockIdx.y of every pixel, traced by a kernel with few registers.
+constexpr int kShadowBlock = 128;
+__global__ void __launch_bounds__(kShadowBlock) shadowQueriesKernel(SceneIntersector sceneIntersector, DeferredShadowsView shadows) {
+  const SceneIntersector intersector = withSharedStack<kShadowBlock>(sceneIntersector);
+  const size_t i = size_t(blockIdx.x) * kShadowBlock + threadIdx.x;
+  if (i < shadows.pixels) answerShadowQuery(intersector, shadows, int(blockIdx.y), i);
+}
+
+// Sample 0's first hits, before the eye-rays kernel shades from them (PrimaryHitsView::traced).
+// The camera rays are a third of an eye pass's rays (Sibenik: 1 of 3-4); traced here, with few
+// registers and full occupancy, they run near the standalone ray rate instead of at the eye
+// kernel's.
+__global__ void __launch_bounds__(kTile* kTile) firstHitsKernel(SceneIntersector sceneIntersector, GatherParams params,
+                                                                 EyeCamera camera, Eye eye, Hit* hits) {
+  const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  int x, y;
+  if (!tilePixel(camera.width, camera.height, x, y)) return;
+  hits[size_t(y) * camera.width + x] = pixelFirstHit(intersector, params, camera, eye, x, y);
+}
 
 template <Estimator E, class Map>
 void launchSingle(const DeviceScene& scene, const Map& map, const GatherParams& params, const EyeCamera& camera,
@@ -92,7 +140,8 @@ StereoReuseView GpuEyePass::prepareReuse(const EyePass& pass, cudaStream_t strea
 }
 
 size_t GpuEyePass::memoryBytes() const {
-  size_t bytes = points_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
+  size_t bytes = points_.bytes() + firstHits_.bytes() + shadowQueries_.bytes() + shadowsAsked_.bytes() +
+                 shadowsBlocked_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
                  reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
                  vertexList_.bytes() + vertexCount_.bytes() + vertexPoints_.bytes() + vertexColours_.bytes() +
                  vertexInverseDepths_.bytes();
@@ -112,7 +161,7 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
   const int e = int(eye);
   const EyeCamera& camera = pass.camera;
   const size_t pixels = size_t(camera.width) * camera.height;
-  const GatherParams& params = pass.gather;
+  GatherParams params = pass.gather;
   const bool knn = params.density.estimator == Estimator::Knn;
   Vec3* image = (images_[e].reserve(pixels, "eye image"), images_[e].data());
   EyeOutputs out;
@@ -136,6 +185,17 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
   }
 
   points_.reserve(pixels, "gather points");
+  // Scatter's reuser takes most pixels from the left eye before any ray: no pre-pass for those.
+  const bool scatterReuser = pass.role == StereoRole::Reuser && pass.reuse == StereoMode::Scatter;
+  const bool apart = pass.raySchedule == RaySchedule::FirstHits || pass.raySchedule == RaySchedule::Deferred;
+  if (apart && !params.primary.present() && !scatterReuser) {
+    firstHits_.reserve(pixels, "first hits");
+    StageScope scope(clock, Stage::EyeRays, e);
+    launch("first hits", firstHitsKernel, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream,
+           scene.intersector, params, camera, eye, firstHits_.data());
+    params.primary.traced = firstHits_.data();
+    params.primary.width = camera.width;
+  }
   const bool sparse = !cached && pass.role == StereoRole::Reuser && map.grid && !knn;  // few points left to estimate
   const bool sorted = !cached && pass.kernel == DensityKernel::CellSorted && !sparse;
   if (cached) map.surfaceCache->prepare(pass.cacheCellSize, 2 * pixels * size_t(params.samplesPerPixel), stream);  // both eyes' points
@@ -161,15 +221,40 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
                                          estimateCount_.data(), int(pixels), NeedsEstimate{points_.view()}, stream));
     temp_.reserve(bytes, "gather-point selection scratch");
   }
-  auto* eyeRays = pass.role == StereoRole::Reuser   ? eyeRaysKernel<StereoRole::Reuser>
-                  : pass.role == StereoRole::Source ? eyeRaysKernel<StereoRole::Source>
-                                                    : eyeRaysKernel<StereoRole::Alone>;
+  const bool deferred = pass.raySchedule == RaySchedule::Deferred;
+  DeferredShadowsView shadows;
+  if (deferred) {
+    shadowQueries_.reserve(kMaxDeferredShadows * pixels, "deferred shadow queries");
+    shadowsAsked_.reserve(pixels, "deferred shadow counts");
+    shadowsBlocked_.reserve(kMaxDeferredShadows * pixels, "deferred shadow answers");
+    shadows = DeferredShadowsView{shadowQueries_.data(), shadowsAsked_.data(), shadowsBlocked_.data(), pixels};
+  }
+  using EyeRaysKernel = void (*)(SceneView, SceneIntersector, GatherParams, EyeCamera, Eye, int, StereoReuseView,
+                                 GatherPointStore, EyeOutputs, DeferredShadowsView);
+  EyeRaysKernel eyeRays = nullptr;
+  if (deferred)
+    eyeRays = pass.role == StereoRole::Reuser   ? eyeRaysKernel<StereoRole::Reuser, true>
+              : pass.role == StereoRole::Source ? eyeRaysKernel<StereoRole::Source, true>
+                                                : eyeRaysKernel<StereoRole::Alone, true>;
+  else
+    eyeRays = pass.role == StereoRole::Reuser   ? eyeRaysKernel<StereoRole::Reuser, false>
+              : pass.role == StereoRole::Source ? eyeRaysKernel<StereoRole::Source, false>
+                                                : eyeRaysKernel<StereoRole::Alone, false>;
+  auto* recordShadows = pass.role == StereoRole::Reuser   ? recordShadowsKernel<StereoRole::Reuser>
+                        : pass.role == StereoRole::Source ? recordShadowsKernel<StereoRole::Source>
+                                                          : recordShadowsKernel<StereoRole::Alone>;
   const int samples = params.samplesPerPixel;
   for (int s = 0; s < samples; ++s) {
     {
       StageScope scope(clock, Stage::EyeRays, e);
+      if (deferred) {
+        launch("record shadow queries", recordShadows, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream,
+               scene.view, scene.intersector, params, camera, eye, s, reuse, out, shadows);
+        const dim3 grid(unsigned((pixels + kShadowBlock - 1) / kShadowBlock), unsigned(kMaxDeferredShadows));
+        launch("shadow queries", shadowQueriesKernel, grid, dim3(kShadowBlock), 0, stream, scene.intersector, shadows);
+      }
       launch("eye rays", eyeRays, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream, scene.view,
-             scene.intersector, params, camera, eye, s, reuse, points_.view(), out);
+             scene.intersector, params, camera, eye, s, reuse, points_.view(), out, shadows);
     }
     StageScope scope(clock, Stage::Density, e);
     if (cached) {

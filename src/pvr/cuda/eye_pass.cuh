@@ -5,6 +5,7 @@
 // Density estimation kernels are in density.cuh.
 #include "pvr/cuda/device_scene.cuh"
 #include "pvr/foveation/reconstruct.h"
+#include "pvr/photon/deferred_shadows.h"
 #include "pvr/pipeline/frame_backend.h"
 
 namespace pvr::cuda {
@@ -161,6 +162,9 @@ class GpuEyePass {
   DeviceBuffer<Vec3> vertexColours_;
   DeviceBuffer<float> vertexInverseDepths_;
   DeviceGatherPoints points_;
+  DeviceBuffer<Hit> firstHits_;  ///< sample 0's, from the first-hit pre-pass
+  DeviceBuffer<ShadowQuery> shadowQueries_;                ///< deferred shadows' (DeferredShadowsView)
+  DeviceBuffer<uint8_t> shadowsAsked_, shadowsBlocked_;
   DeviceBuffer<uint32_t> sortKeys_[2], sortValues_[2];
   DeviceBuffer<unsigned char> temp_;
 };

@@ -8,15 +8,6 @@
 namespace pvr::cuda {
 namespace {
 
-// Floats as ints whose order is the floats' order, for atomicMin/atomicMax on bounds.
-PVR_HOST_DEVICE inline int orderedFromFloat(float f) {
-  int i = int(floatBits(f));
-  return i >= 0 ? i : i ^ 0x7FFFFFFF;
-}
-PVR_HOST_DEVICE inline float floatFromOrdered(int i) {
-  return floatFromBits(uint32_t(i >= 0 ? i : i ^ 0x7FFFFFFF));
-}
-
 constexpr int kPhotonBlock = 128;
 
 // Persistent lanes: a lane whose path ended takes the next photon index (a warp fetches for all
@@ -25,7 +16,7 @@ constexpr int kPhotonBlock = 128;
 // and output slots follow its index, so the result does not depend on which lane traced it.
 __global__ void __launch_bounds__(kPhotonBlock) tracePhotonsKernel(SceneView scene, SceneIntersector sceneIntersector,
                                                                    PhotonTraceParams params, uint32_t first, uint32_t n,
-                                                                   Photon* slots, uint32_t* counts, int* bounds,
+                                                                   Photon* slots, uint32_t* counts, uint32_t* bounds,
                                                                    uint32_t* nextPhoton) {
   const SceneIntersector intersector = withSharedStack<kPhotonBlock>(sceneIntersector);
   const unsigned lane = threadIdx.x & 31u;
@@ -63,8 +54,8 @@ __global__ void __launch_bounds__(kPhotonBlock) tracePhotonsKernel(SceneView sce
     }
   if (lane == 0 && v[0] <= v[3]) {
     for (int a = 0; a < 3; ++a) {
-      atomicMin(bounds + a, orderedFromFloat(v[a]));
-      atomicMax(bounds + 3 + a, orderedFromFloat(v[3 + a]));
+      atomicMin(bounds + a, orderedBits(v[a]));
+      atomicMax(bounds + 3 + a, orderedBits(v[3 + a]));
     }
   }
 }
@@ -80,7 +71,7 @@ __global__ void compactPhotonsKernel(const Photon* slots, const uint32_t* counts
 
 }  // namespace
 
-GpuPhotonTracer::GpuPhotonTracer() { PVR_CUDA_CHECK(cudaMallocHost(&hostSummary_, 8 * sizeof(int))); }
+GpuPhotonTracer::GpuPhotonTracer() { PVR_CUDA_CHECK(cudaMallocHost(&hostSummary_, 8 * sizeof(uint32_t))); }
 GpuPhotonTracer::~GpuPhotonTracer() { cudaFreeHost(hostSummary_); }
 
 size_t GpuPhotonTracer::memoryBytes() const {
@@ -108,23 +99,23 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
     PVR_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perMultiprocessor, tracePhotonsKernel, kPhotonBlock, 0));
     return unsigned(std::max(perMultiprocessor, 1) * multiprocessorCount());
   }();
-  int init[6];
-  for (int a = 0; a < 3; ++a) init[a] = orderedFromFloat(INFINITY), init[3 + a] = orderedFromFloat(-INFINITY);
+  uint32_t init[6];
+  for (int a = 0; a < 3; ++a) init[a] = orderedBits(INFINITY), init[3 + a] = orderedBits(-INFINITY);
   PVR_CUDA_CHECK(cudaMemcpyAsync(summary_.data(), init, sizeof init, cudaMemcpyHostToDevice, stream));
   uint32_t stored = 0;
   for (uint32_t first = params.firstPhoton; first < last; first += chunk) {
     uint32_t n = std::min(chunk, last - first);
     PVR_CUDA_CHECK(cudaMemsetAsync(counts_.data() + n, 0, sizeof(uint32_t), stream));
-    PVR_CUDA_CHECK(cudaMemsetAsync(summary_.data() + 6, 0, sizeof(int), stream));  // the next photon to start
+    PVR_CUDA_CHECK(cudaMemsetAsync(summary_.data() + 6, 0, sizeof(uint32_t), stream));  // the next photon to start
     launch("photon trace", tracePhotonsKernel, std::min(blocksFor(n, kPhotonBlock), residentBlocks), kPhotonBlock, 0, stream,
            scene.view, scene.intersector, params, first, n, slots_.data(), counts_.data(), summary_.data(),
-           reinterpret_cast<uint32_t*>(summary_.data() + 6));
+           summary_.data() + 6);
     size_t bytes = temp_.capacity();
     PVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, counts_.data(), offsets_.data(), n + 1, stream));
-    PVR_CUDA_CHECK(cudaMemcpyAsync(hostSummary_, summary_.data(), 6 * sizeof(int), cudaMemcpyDeviceToHost, stream));
+    PVR_CUDA_CHECK(cudaMemcpyAsync(hostSummary_, summary_.data(), 6 * sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
     PVR_CUDA_CHECK(cudaMemcpyAsync(hostSummary_ + 6, offsets_.data() + n, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
     PVR_CUDA_CHECK(cudaStreamSynchronize(stream));
-    uint32_t added = uint32_t(hostSummary_[6]);
+    uint32_t added = hostSummary_[6];
     if (size_t(stored) + added > photons_.capacity()) {  // grow, keeping earlier chunks
       DeviceBuffer<Photon> bigger;
       bigger.reserve(std::max<size_t>(size_t(stored + added) * 5 / 4, 1024), "stored photons");
@@ -140,8 +131,8 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
   count_ = stored;
   bounds_ = Bounds3();
   if (stored) {
-    bounds_.lower = {floatFromOrdered(hostSummary_[0]), floatFromOrdered(hostSummary_[1]), floatFromOrdered(hostSummary_[2])};
-    bounds_.upper = {floatFromOrdered(hostSummary_[3]), floatFromOrdered(hostSummary_[4]), floatFromOrdered(hostSummary_[5])};
+    bounds_.lower = {fromOrderedBits(hostSummary_[0]), fromOrderedBits(hostSummary_[1]), fromOrderedBits(hostSummary_[2])};
+    bounds_.upper = {fromOrderedBits(hostSummary_[3]), fromOrderedBits(hostSummary_[4]), fromOrderedBits(hostSummary_[5])};
   }
   return stored;
 }

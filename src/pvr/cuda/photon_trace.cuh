@@ -23,9 +23,9 @@ class GpuPhotonTracer {
  private:
   DeviceBuffer<Photon> slots_, photons_;
   DeviceBuffer<uint32_t> counts_, offsets_;
-  DeviceBuffer<int> summary_;  ///< 6 ordered-int bounds
+  DeviceBuffer<uint32_t> summary_;  ///< the bounds (6, as orderedBits) and the next photon to start
   DeviceBuffer<unsigned char> temp_;
-  int* hostSummary_ = nullptr;  ///< pinned: bounds and the chunk's count
+  uint32_t* hostSummary_ = nullptr;  ///< pinned: bounds and the chunk's count
   uint32_t count_ = 0;
   Bounds3 bounds_;
 };

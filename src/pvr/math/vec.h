@@ -28,6 +28,14 @@ PVR_HOST_DEVICE inline float floatFromBits(uint32_t bits) {
 #endif
 }
 
+// A float's bits as an unsigned integer ordered as the floats are, -0 as +0 (so that ties are
+// those of the CPU's <): atomicMin/atomicMax keep bounds in it, radix sorts rank floats by it.
+PVR_HOST_DEVICE inline uint32_t orderedBits(float v) {
+  const uint32_t b = floatBits(v == 0.0f ? 0.0f : v);
+  return (b & 0x80000000u) ? ~b : (b | 0x80000000u);
+}
+PVR_HOST_DEVICE inline float fromOrderedBits(uint32_t o) { return floatFromBits((o & 0x80000000u) ? (o & 0x7fffffffu) : ~o); }
+
 struct Vec2 {
   float x = 0, y = 0;
 };

@@ -42,8 +42,9 @@ struct GatherParams {
   // refinement): each pixel's samples go on along their sequences, and the photons and hashed
   // numbers are new every frame. 0: a frame on its own.
   uint32_t sequenceIndex = 0;
-  // Sample 0's first hits rasterised (the G-buffer pre-pass), set by the backend for one eye pass;
-  // none: traced. Ignored when the first sample is jittered.
+  // Sample 0's first hits found before the eye pass, set by the backend for one eye pass: traced
+  // by a pre-pass (any sample position), or rasterised (the G-buffer pre-pass; ignored when the
+  // first sample is jittered); none: traced in place.
   PrimaryHitsView primary;
   // Every material's effect level replaced by `effects`; else its group's level where that is
   // set (not kOwnEffectLevel), else the surface's own (Material::effect).
@@ -192,6 +193,19 @@ PVR_HOST_DEVICE Vec3 punctualDirectLight(const SceneView& scene, const Intersect
       chosenSum += chosen.value * (total / chosenWeight);
   }
   return sum + chosenSum * (1.0f / float(shadowRays));
+}
+
+// The shadow rays diffuseDirectLight asks at a Lambertian point that faces every light: one per
+// distant light, `shadowRays` among the local ones (or one per local light where that is fewer, or
+// shadowRays is 0), one for the area lights and one for the sky. (A microfacet point asks only the
+// punctual lights'; mirrors and glass ask none.)
+PVR_HOST_DEVICE inline int shadowQueriesPerPoint(const SceneView& scene, int shadowRays) {
+  int distant = 0, local = 0;
+  for (uint32_t k = 0; k < scene.punctualCount; ++k)
+    (scene.punctualLights[k].kind == PunctualKind::Directional ? distant : local) += 1;
+  const bool chooseLocal = shadowRays > 0 && shadowRays < local;
+  return distant + (chooseLocal ? shadowRays : local) + (scene.triangleLightCount > 0 ? 1 : 0) +
+         (scene.sky.present() ? 1 : 0);
 }
 
 // One sample of the area lights' direct light at a surface point (front side only).
@@ -520,6 +534,18 @@ PVR_HOST_DEVICE inline Ray pixelSampleRay(const GatherParams& params, const EyeC
   return camera.generateRay(float(x) + jx, float(y) + jy);
 }
 
+// Sample 0's first hit of pixel (x, y), exactly as pixelGatherPoint traces it in place: what a
+// first-hit pre-pass stores (PrimaryHitsView::traced).
+template <class Intersector>
+PVR_HOST_DEVICE Hit pixelFirstHit(const Intersector& intersector, const GatherParams& params, const EyeCamera& camera,
+                                  Eye eye, int x, int y) {
+  CounterRng rng(0, 0, 0);
+  const Ray ray = pixelSampleRay(params, camera, eye, x, y, 0, rng);
+  Hit first;
+  intersector.intersect(ray, INFINITY, first);
+  return first;
+}
+
 // The inverse view depth of a camera ray's first hit (0: none).
 PVR_HOST_DEVICE inline float firstHitInverseDepth(const EyeCamera& camera, const Ray& ray, const Hit& first) {
   return first.valid() ? camera.inverseDepthOf(ray.origin + ray.dir * first.t) : 0.0f;
@@ -573,8 +599,10 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
   if (s > 0) return traceToGatherPoint(scene, intersector, params, ray, rng, nullptr, camera.pixelSpread());
   Hit first;
-  if (!params.primary.present() || params.jitterFirstSample ||
-      !rasterisedFirstHit(scene, params.primary, x, y, ray, first))
+  if (params.primary.traced)
+    first = params.primary.traced[size_t(y) * size_t(params.primary.width) + size_t(x)];
+  else if (!params.primary.present() || params.jitterFirstSample ||
+           !rasterisedFirstHit(scene, params.primary, x, y, ray, first))
     intersector.intersect(ray, INFINITY, first);
   pixel.firstPrim = first.primId;
   pixel.inverseDepth = firstHitInverseDepth(camera, ray, first);

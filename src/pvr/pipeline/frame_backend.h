@@ -52,6 +52,7 @@ struct EyePass {
   float cacheCellSize = 0.0f;  ///< the surface cache's cell side (scene units)
   StereoRole role = StereoRole::Alone;
   bool rasterPrimary = false;  ///< sample 0's first hits from the frame's G-buffer pre-pass (rasterizePrimary)
+  RaySchedule raySchedule = RaySchedule::Auto;  ///< the GPU's (RenderOptions)
   StereoMode reuse = StereoMode::Separate;  ///< the reuser's: scatter or gather
   EyeCamera source;                          ///< the reuser's: the eye it reuses (the left)
   const FoveationMask* mask = nullptr;       ///< foveated: the mask, placed at the gaze pixel

@@ -18,6 +18,14 @@ const char* densityKernelName(DensityKernel k) {
 
 const char* densitySchemeName(DensityScheme s) { return s == DensityScheme::SurfaceCache ? "cache" : "pixel"; }
 const char* primaryVisibilityName(PrimaryVisibility p) { return p == PrimaryVisibility::Raster ? "raster" : "rays"; }
+const char* rayScheduleName(RaySchedule s) {
+  switch (s) {
+    case RaySchedule::InKernel: return "in-kernel";
+    case RaySchedule::FirstHits: return "first-hits";
+    case RaySchedule::Deferred: return "deferred";
+    default: return "auto";
+  }
+}
 
 void validateRig(const StereoRig& rig) {
   if (rig.width < 1 || rig.height < 1 || rig.width > kMaxEyeDimension || rig.height > kMaxEyeDimension)

@@ -41,6 +41,28 @@ enum class PrimaryVisibility : int {
 };
 const char* primaryVisibilityName(PrimaryVisibility p);  ///< "rays" | "raster"
 
+// Where the GPU's full-resolution eye passes trace their rays (hybrid, shared-memory, cell-sorted
+// and cache schemes with traced first hits; the paper's single kernel and foveated passes keep
+// them in one kernel). The image is the same each way but for rounding (the compiler contracts
+// the shading arithmetic differently in each kernel); the CPU always traces in place.
+enum class RaySchedule : int {
+  Auto = 0,      ///< per eye pass by its shadow queries per gather point (eyeRayScheduleFor)
+  InKernel = 1,  ///< camera, shadow and specular rays all in the eye kernel (the paper's hybrid)
+  FirstHits = 2, ///< sample 0's camera rays in a kernel of their own (PrimaryHitsView::traced)
+  Deferred = 3,  ///< FirstHits, and the shadow rays in a kernel of their own (photon/deferred_shadows.h)
+};
+const char* rayScheduleName(RaySchedule s);  ///< "auto" | "in-kernel" | "first-hits" | "deferred"
+
+// Auto's choice for an eye pass whose gather points ask `shadowQueries` shadow rays each: kernels
+// of their own pay where a point asks several (the eye kernel's registers then hold up more rays:
+// measured 2026-12-05 on the H100, docs/benchmarks.md), not where it asks one (cornell-dense's
+// area light). A right eye that reuses the left's shading shades few pixels: no deferral there.
+inline RaySchedule eyeRayScheduleFor(int shadowQueries, bool reuser) {
+  if (shadowQueries >= 3 && !reuser) return RaySchedule::Deferred;
+  if (shadowQueries >= 2) return RaySchedule::FirstHits;
+  return RaySchedule::InKernel;
+}
+
 struct RenderOptions {
   uint32_t photonsX = 256, photonsY = 256;  ///< emitted photons = photonsX * photonsY (the paper's NxN)
   int maxPhotonDepth = 8;
@@ -55,6 +77,7 @@ struct RenderOptions {
   DensityScheme density = DensityScheme::PerPixel;
   float cacheCellFraction = kDefaultCacheCellFraction;  ///< the surface cache's cell side over the radius
   PrimaryVisibility primary = PrimaryVisibility::Rays;
+  RaySchedule raySchedule = RaySchedule::Auto;
   GatherParams gather;  ///< radius, estimator, k, shading mode, spp, seed
   bool eyes[2] = {true, true};
   StereoMode stereo = StereoMode::Separate;  ///< how the right eye reuses the left eye's shading

@@ -271,6 +271,7 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
     pass.denoiseGuides = options.denoise.enabled || options.temporal.enabled;
     pass.stillFrames = stillFrames_;
     pass.rasterPrimary = raster;
+    pass.raySchedule = options.raySchedule;
     pass.role = !reusing ? StereoRole::Alone : eye == Eye::Left ? StereoRole::Source : StereoRole::Reuser;
     if (pass.role == StereoRole::Reuser) {
       pass.reuse = options.stereo;

@@ -1,8 +1,10 @@
 #pragma once
-// Sample 0's first hits of one eye as a rasterised visibility buffer gives them (gbuffer_raster.h,
-// Ray-VR's G-buffer pre-pass): per pixel the triangle seen at the pixel centre and its
-// barycentrics. The eye pass starts from them instead of tracing its primary rays. Written once
-// for both backends (host and device pointers alike).
+// Sample 0's first hits of one eye, found before the eye pass: either as a rasterised visibility
+// buffer gives them (gbuffer_raster.h, Ray-VR's G-buffer pre-pass: per pixel the triangle seen at
+// the pixel centre and its barycentrics), or traced by a camera-ray kernel of their own (the GPU's
+// first-hit pre-pass: a lean kernel traces at the standalone ray rate, where the eye kernel's
+// registers held the same rays to a third of it). The eye pass starts from them instead of
+// tracing its primary rays. Written once for both backends (host and device pointers alike).
 #include <cstddef>
 #include <cstdint>
 
@@ -15,6 +17,9 @@ namespace pvr {
 struct PrimaryHitsView {
   const uint32_t* prim = nullptr;      ///< per pixel, row-major: the triangle, ~0u for none (the sky)
   const Vec2* barycentrics = nullptr;  ///< per pixel: of the triangle's vertices 1 and 2 (Hit::u, Hit::v)
+  // Or, per pixel, the hit of sample 0's own ray (jittered or not) as the intersector reported it:
+  // taken as it is, so the pass's result is bit for bit that of tracing it in place.
+  const Hit* traced = nullptr;
   int width = 0;
   PVR_HOST_DEVICE bool present() const { return prim != nullptr; }
 };
