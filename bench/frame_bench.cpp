@@ -955,7 +955,8 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
       if (cells[c].schedule != RaySchedule::Auto)
         for (int e = 0; e < 2; ++e) {
           scheduleRelMse[e] = compareToReference(r.last.eyes[e].image, gatherFrame.eyes[e].image).relMse;
-          ok = ok && scheduleRelMse[e] < 1e-8 && *r.last.eyes[e].firstPrim == *gatherFrame.eyes[e].firstPrim;
+          // Far below the frame's own error: rounding, and the rare light choice or reuse decision it tips.
+          ok = ok && scheduleRelMse[e] < 1e-4 * ref[e].relMse && *r.last.eyes[e].firstPrim == *gatherFrame.eyes[e].firstPrim;
         }
       failures += ok ? 0 : 1;
       std::printf("| %s | %dx%d | 512x512 | %g (%.2f %%) | %s | %s | %s | %s | %s | %s | %.2f | %.2f | %.3f / %.3f | "
@@ -973,7 +974,8 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
                     rayScheduleName(eyeRayScheduleFor(queries, true)), queries);
       }
       if (cells[c].schedule != RaySchedule::Auto)
-        std::printf("| %s | %s: relMSE against the gather cell's image %.2g / %.2g (rounding), the same first hits |\n",
+        std::printf("| %s | %s: relMSE against the gather cell's image %.2g / %.2g (rounding; must be < 1e-4 of the "
+                    "error), the same first hits |\n",
                     scene.name.c_str(), cells[c].name, scheduleRelMse[0], scheduleRelMse[1]);
       nlohmann::json cell = r.latencyJson();
       cell.update({{"suite", "scenes"}, {"scene", scene.name}, {"variant", cells[c].name}, {"backend", renderer->name()},

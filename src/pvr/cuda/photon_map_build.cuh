@@ -6,7 +6,7 @@
 namespace pvr::cuda {
 
 // The paper's hash grid, built on the GPU: cell keys, CUB radix sort of (cell, index) pairs,
-// startIdx by a scan of the cell counts, photons gathered in cell order.
+// startIdx from a search of the sorted keys per cell, photons gathered in cell order.
 class GpuHashGrid {
  public:
   void build(const Photon* photons, uint32_t count, const Bounds3& bounds, float radius, cudaStream_t stream);
@@ -17,7 +17,7 @@ class GpuHashGrid {
   void download(std::vector<Photon>& photons, std::vector<uint32_t>& cellStart, std::vector<uint32_t>& sortedToInput) const;
 
  private:
-  DeviceBuffer<uint32_t> keys_[2], values_[2], counts_, cellStart_;
+  DeviceBuffer<uint32_t> keys_[2], values_[2], cellStart_;
   DeviceBuffer<Photon> sorted_;
   DeviceBuffer<PackedPosition> positions_;
   DeviceBuffer<unsigned char> temp_;
