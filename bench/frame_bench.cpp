@@ -916,10 +916,9 @@ int runScenes(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json
       RaySchedule schedule = RaySchedule::Auto;
     };
     // The textured cells choose one punctual light per shadow ray; "every light" shows what one
-    // exact ray per light costs, the untextured cell what texture sampling costs, and the last
-    // what the GPU's first-hit pre-pass saves (the camera rays traced by the eye kernel instead:
-    // the same image up to rounding, checked), and what deferring the shadow rays to a kernel of
-    // their own saves (likewise); "gather" takes the schedule RaySchedule::Auto picks.
+    // exact ray per light costs, the untextured cell what texture sampling costs. On the GPU the last
+    // three fix the ray schedule (all rays in the eye kernel, first hits apart, shadow rays apart too)
+    // and must give the gather cell's image to rounding; "gather" takes RaySchedule::Auto's choice.
     const Cell allCells[] = {{"separate", renderer.get(), StereoMode::Separate, 1},
                              {"gather", renderer.get(), StereoMode::Gather, 1},
                              {"gather, a ray to every light", renderer.get(), StereoMode::Gather, 0},
