@@ -45,6 +45,7 @@ struct Variant {
   bool freshNoise = true;  ///< new random numbers every frame (the default under TAA or the denoiser)
   PixelSampling sampling = PixelSampling::BlueNoise;
   Boundary boundary = Boundary::Sphere;  ///< the estimate where surfaces meet walls or end (photon/boundary.h)
+  StereoMode stereo = StereoMode::Separate;
 };
 constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"TAA", false, true, 1},
@@ -61,7 +62,21 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"denoise + TAA, white noise", true, true, 1, true, PixelSampling::White},
                                  // The estimate clipped at walls and edges (--boundary clipped) against the paper's sphere.
                                  {"raw, clipped", false, false, 1, true, PixelSampling::BlueNoise, Boundary::Clipped},
-                                 {"denoise + TAA, clipped", true, true, 1, true, PixelSampling::BlueNoise, Boundary::Clipped}};
+                                 {"denoise + TAA, clipped", true, true, 1, true, PixelSampling::BlueNoise, Boundary::Clipped},
+                                 // The right eye reusing the left eye's shading (and its denoise).
+                                 {"raw, gather reuse", false, false, 1, true, PixelSampling::BlueNoise, Boundary::Sphere,
+                                  StereoMode::Gather},
+                                 {"denoise, gather reuse", true, false, 1, true, PixelSampling::BlueNoise, Boundary::Sphere,
+                                  StereoMode::Gather}};
+
+// Whether the run asked for variant v (--quality-variants; the first, "raw", is every ratio's base
+// and always runs).
+bool selected(const FrameBenchArgs& args, const Variant& v) {
+  if (args.qualityVariants.empty() || &v == &kVariants[0]) return true;
+  for (const std::string& name : splitList(args.qualityVariants, ';'))
+    if (name == v.name) return true;
+  return false;
+}
 
 // Flicker of shown frames a -> b where the reference does not change: the mean absolute change of
 // luminance over the pixels whose references differ by less than 2 % (and 0.002 absolute), over
@@ -121,6 +136,10 @@ bool isSampled(int frame) {
 
 int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json) {
   int failures = 0;
+  if (!args.qualityVariants.empty())
+    for (const std::string& name : splitList(args.qualityVariants, ';'))
+      if (std::none_of(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; }))
+        throw Error("--quality-variants: no variant '" + name + "' in the quality suite");
   if (args.referencePasses < 2 || args.referencePasses > kMaxReferencePasses / 4)
     throw Error("--reference-passes must be between 2 and " + std::to_string(kMaxReferencePasses / 4));
   std::printf("\nImage quality at the real-time settings (512x512 photons, 1 sample per pixel, full shading, hash grid, "
@@ -195,10 +214,12 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                 "frame ms (mean / p99) | check |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     double rawRelMse = 0, rawFlicker = 0, rawUnexplained = 0;
     for (const Variant& v : kVariants) {
+      if (!selected(args, v)) continue;
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
       RenderOptions vo = o;
       vo.denoise.enabled = v.denoise;
       vo.temporal.enabled = v.taa;
+      vo.stereo = v.stereo;
       vo.photonBatches = v.photonBatches;
       vo.gather.sampling = v.sampling;
       vo.gather.density.boundary = v.boundary;
@@ -257,7 +278,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"unexplained_flicker_of_raw", rawUnexplained > 0 ? un / rawUnexplained : 1.0},
                       {"fresh_noise", v.freshNoise},
                       {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"},
-                      {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"}, {"denoise_ms", dn},
+                      {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"},
+                      {"stereo", stereoModeName(v.stereo)}, {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});
     }
@@ -270,6 +292,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                 "SSIM after 5 s | then moving: largest change in 10 frames / moving median | check |\n"
                 "|---|---|---|---|---|---|---|---|---|---|\n");
     for (const Variant& v : kVariants) {
+      if (!selected(args, v)) continue;
       if (v.taa && !v.denoise) continue;  // TAA alone is the moving head's business
       // A still head retraces every photon each frame anyway, and refines with new numbers.
       if (v.photonBatches > 1 || !v.freshNoise) continue;
@@ -277,6 +300,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       RenderOptions vo = o;
       vo.denoise.enabled = v.denoise;
       vo.temporal.enabled = v.taa;
+      vo.stereo = v.stereo;
       vo.gather.sampling = v.sampling;
       vo.gather.density.boundary = v.boundary;
       ReferenceError at[3];

@@ -108,6 +108,7 @@ expect_error "--walks must name SCENE=TRAJECTORY" bench --suite controller --bac
 expect_error "--budgets must be" bench --suite controller --backend cpu --walks "cornell=$out/one.traj" --budgets 5,x
 expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty
 expect_error "--reference-passes must be between 2" bench --suite quality --reference-passes 1 --backend cpu
+expect_error "--quality-variants: no variant 'denoised'" bench --suite quality --quality-variants "denoise;denoised" --backend cpu
 expect_error "--suite must be" bench --suite speed
 expect_error "--frames must be" bench --suite tables --frames 0
 expect_error "--tables takes" bench --suite tables --backend cpu --tables 5 --eye-size 8x8 --frames 1

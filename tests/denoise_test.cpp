@@ -13,6 +13,7 @@
 #include "pvr/image/image_compare.h"
 #include "pvr/reference/progressive_reference.h"
 #include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
 
 namespace pvr {
 namespace {
@@ -264,6 +265,82 @@ TEST(Denoise, WithoutGuidesTheWholeImageIsOneSignal) {
     denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), in, out, frame);
     EXPECT_LT(maxRelativeError(out, f.image), 1e-5) << "frame " << frame;
   }
+}
+
+// A noisy frame of a checker-textured plane: the same inputs for both eyes of the reuse tests.
+SyntheticFrame noisyPlane(int w, int h, unsigned seed) {
+  SyntheticFrame f(w, h);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) f.set(x, y, checker(x, y), Vec3(0.5f * noise(rng)), Vec3(0.2f * noise(rng)));
+  return f;
+}
+
+// Stereo reuse: a right eye whose left half took the left eye's shading denoises that half once,
+// in the left eye. With the same inputs as the left eye its pixels come out bit for bit as the left
+// eye's (the reused pixels' filter levels are the left eye's), whatever its reused pixels rendered
+// themselves; and next frame, shaded by itself, it carries the left eye's history on.
+TEST(Denoise, ReusedPixelsShareTheLeftEyesFilterAndHistory) {
+  const int w = 64, h = 48;
+  HostDenoiser denoiser;
+  Image left, right;
+  SyntheticFrame f = noisyPlane(w, h, 21);
+  SyntheticFrame rendered = f;  // the right eye's own rendering, 1000x off where it reused
+  std::vector<uint32_t> reusedFrom(size_t(w) * h, kNotReused);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w / 2; ++x) {
+      reusedFrom[f.at(x, y)] = uint32_t(f.at(x, y));
+      rendered.image[f.at(x, y)] *= 1000.0f, rendered.direct[f.at(x, y)] *= 1000.0f;
+    }
+  DenoiseInputs leftIn = f.inputs();
+  leftIn.keepLevels = true;
+  denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), leftIn, left);
+  DenoiseInputs rightIn = rendered.inputs();
+  rightIn.reusedFrom = reusedFrom.data();
+  rightIn.sourceNormal = f.normal.data();
+  rightIn.sourceDenoised = left.pixels.data();
+  EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right), 0u);
+  for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
+
+  // Next frame nothing is reused: every right pixel keeps a history (the reused ones the left
+  // eye's) and the two eyes stay alike to the bit.
+  SyntheticFrame second = noisyPlane(w, h, 22);
+  denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), second.inputs(), left);
+  EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), second.inputs(), right), size_t(w) * h);
+  for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
+
+  // The left eye must have kept its levels for a reusing right eye.
+  EXPECT_THROW(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right), Error);
+}
+
+// Background (nothing hit) is not filtered: it shows what the eye pass rendered, to the bit, and
+// what it holds never reaches a surface beside it.
+TEST(Denoise, BackgroundShowsTheRenderedImage) {
+  const int w = 48, h = 40;
+  Image out[2];
+  for (int run = 0; run < 2; ++run) {
+    SyntheticFrame f = noisyPlane(w, h, 31);
+    std::vector<Vec3> emitted(size_t(w) * h, Vec3(0.0f));
+    std::mt19937 rng(32 + run);
+    std::uniform_real_distribution<float> sky(0.5f, 50.0f);
+    for (int y = 0; y < h / 3; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t i = f.at(x, y);
+        f.inverseDepth[i] = 0.0f, f.normal[i] = Vec3(0.0f);
+        f.image[i] = f.direct[i] = emitted[i] = Vec3(sky(rng), sky(rng), sky(rng));
+      }
+    DenoiseInputs in = f.inputs();
+    in.emitted = emitted.data();
+    HostDenoiser denoiser;
+    for (int frame = 0; frame < 3; ++frame) {
+      denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), in, out[run]);
+      for (int y = 0; y < h / 3; ++y)
+        for (int x = 0; x < w; ++x) ASSERT_EQ(out[run].pixels[f.at(x, y)], f.image[f.at(x, y)]) << x << "," << y;
+    }
+  }
+  for (int y = h / 3; y < h; ++y)
+    for (int x = 0; x < w; ++x) ASSERT_EQ(out[0].pixels[size_t(y) * w + x], out[1].pixels[size_t(y) * w + x]) << x << "," << y;
 }
 
 // The Cornell box through the frame pipeline at real-time settings (one sample per pixel, few

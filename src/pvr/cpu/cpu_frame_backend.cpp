@@ -162,12 +162,11 @@ void CpuFrameBackend::denoise(const EyePass& pass, const DenoiseParams& params) 
     in.sampleSpacing = b.sampleSpacing.data();
   } else {
     in.emitted = b.emitted.data(), in.direct = b.direct.data(), in.albedo = b.albedo.data(), in.normal = b.normal.data();
+    in.keepLevels = pass.role == StereoRole::Source;
     if (pass.role == StereoRole::Reuser) {
       const EyeBuffers& left = eyes_[int(Eye::Left)];
       in.reusedFrom = b.reusedFrom.data();
-      in.sourceImage = left.rendered.pixels.data();
-      in.sourceEmitted = left.emitted.data(), in.sourceDirect = left.direct.data();
-      in.sourceAlbedo = left.albedo.data(), in.sourceNormal = left.normal.data();
+      in.sourceNormal = left.normal.data();
       in.sourceDenoised = left.denoised.pixels.data();
     }
   }

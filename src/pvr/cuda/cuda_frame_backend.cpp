@@ -257,11 +257,9 @@ void CudaFrameBackend::denoise(const EyePass& pass, const DenoiseParams& params)
   } else {
     in.emitted = m.eyePass.emitted(eye), in.direct = m.eyePass.direct(eye);
     in.albedo = m.eyePass.albedo(eye), in.normal = m.eyePass.normal(eye);
+    in.keepLevels = pass.role == StereoRole::Source;
     if (pass.role == StereoRole::Reuser) {
       in.reusedFrom = m.eyePass.reusedFrom();
-      in.sourceImage = m.eyePass.image(Eye::Left);
-      in.sourceEmitted = m.eyePass.emitted(Eye::Left), in.sourceDirect = m.eyePass.direct(Eye::Left);
-      in.sourceAlbedo = m.eyePass.albedo(Eye::Left);
       in.sourceNormal = m.eyePass.normal(Eye::Left);
       in.sourceDenoised = m.denoiser.image(Eye::Left);
     }

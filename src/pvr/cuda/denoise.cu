@@ -1,9 +1,14 @@
 #include "pvr/cuda/denoise.cuh"
 
+#include <algorithm>
+
+#include "pvr/util/error.h"
+
 namespace pvr::cuda {
 namespace {
 
 constexpr int kBlock = 16;
+constexpr unsigned kListThreads = 256;
 
 __device__ inline bool blockPixel(const EyeCamera& c, int& x, int& y) {
   x = int(blockIdx.x) * kBlock + int(threadIdx.x);
@@ -11,25 +16,49 @@ __device__ inline bool blockPixel(const EyeCamera& c, int& x, int& y) {
   return x < c.width && y < c.height;
 }
 
-__global__ void accumulateKernel(DenoiseFrameView v, unsigned* historyPixels) {
+// Appends `value` to list[*count] for each thread of the warp whose flag is set, one atomic per
+// warp: a warp's pixels (two rows of 16 neighbours) stay together, so the later passes' taps are
+// as coherent as over the whole image.
+__device__ inline void appendInWarp(uint32_t* list, unsigned* count, bool flag, uint32_t value) {
+  const unsigned active = __activemask();
+  const unsigned set = __ballot_sync(active, flag);
+  if (!set) return;
+  const unsigned lane = (threadIdx.y * blockDim.x + threadIdx.x) & 31u;
+  const unsigned leader = unsigned(__ffs(int(set)) - 1);
+  unsigned base = 0;
+  if (lane == leader) base = atomicAdd(count, unsigned(__popc(int(set))));
+  base = __shfl_sync(active, base, int(leader));
+  if (flag) list[base + unsigned(__popc(int(set & ((1u << lane) - 1u))))] = value;
+}
+
+__global__ void accumulateKernel(DenoiseFrameView v, uint32_t* filtered, unsigned* filteredCount) {
   int x, y;
   const bool inside = blockPixel(v.camera, x, y);
-  countInWarp(historyPixels, inside && accumulateDenoisePixel(v, x, y));
+  const size_t pixel = inside ? denoisePixel(v.camera, x, y) : 0;
+  if (inside) accumulateDenoisePixel(v, x, y);
+  appendInWarp(filtered, filteredCount, inside && filtersPixel(v, pixel), uint32_t(pixel));
 }
 
-__global__ void varianceKernel(DenoiseFrameView v) {
-  int x, y;
-  if (blockPixel(v.camera, x, y)) estimateDenoiseVariance(v, x, y);
+// The later passes: a grid-stride loop over the listed pixels.
+template <class Pass>
+__device__ inline void forEachListed(const DenoiseFrameView& v, const uint32_t* pixels, const unsigned* count, Pass pass) {
+  const unsigned n = *count;
+  for (unsigned i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) {
+    const uint32_t pixel = pixels[i];
+    pass(int(pixel % unsigned(v.camera.width)), int(pixel / unsigned(v.camera.width)));
+  }
 }
 
-__global__ void atrousKernel(DenoiseFrameView v, int iteration) {
-  int x, y;
-  if (blockPixel(v.camera, x, y)) atrousDenoisePixel(v, iteration, x, y);
+__global__ void varianceKernel(DenoiseFrameView v, const uint32_t* pixels, const unsigned* count) {
+  forEachListed(v, pixels, count, [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
 }
 
-__global__ void remodulateKernel(DenoiseFrameView v) {
-  int x, y;
-  if (blockPixel(v.camera, x, y)) remodulateAccumulated(v, x, y);
+__global__ void atrousKernel(DenoiseFrameView v, int iteration, const uint32_t* pixels, const unsigned* count) {
+  forEachListed(v, pixels, count, [&](int x, int y) { atrousDenoisePixel(v, iteration, x, y); });
+}
+
+__global__ void remodulateKernel(DenoiseFrameView v, const uint32_t* pixels, const unsigned* count) {
+  forEachListed(v, pixels, count, [&](int x, int y) { remodulateAccumulated(v, x, y); });
 }
 
 }  // namespace
@@ -44,11 +73,10 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
     state.valid = false;
   History& previous = state.history[state.latest];
   History& next = state.history[state.latest ^ 1];
+  const int levels = in.keepLevels ? params.iterations + 1 : 2;
   for (int s = 0; s < signals; ++s) {
     next.colour[s].reserve(pixels, "denoiser history");
-    state.accumulated[s].reserve(pixels, "denoiser accumulation");
-    state.filtered[s][0].reserve(pixels, "denoiser filter");
-    state.filtered[s][1].reserve(pixels, "denoiser filter");
+    for (int k = 0; k < levels; ++k) state.levels[s][k].reserve(pixels, "denoiser filter levels");
   }
   next.moments.reserve(4 * pixels, "denoiser moments");
   next.length.reserve(pixels, "denoiser history length");
@@ -56,7 +84,8 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   state.albedo.reserve(pixels, "denoiser albedo");
   state.depthGradient.reserve(2 * pixels, "denoiser depth gradient");
   state.out.reserve(pixels, "denoised image");
-  historyPixels_.reserve(2, "denoiser history count");
+  state.filteredPixels.reserve(pixels, "denoiser pixel list");
+  filteredCount_.reserve(2, "denoiser pixel count");
 
   DenoiseFrameView v;
   v.camera = camera;
@@ -76,40 +105,54 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   v.moments = next.moments.data();
   v.length = next.length.data();
   for (int s = 0; s < signals; ++s) {
-    v.accumulated[s] = state.accumulated[s].data();
-    v.filtered[s][0] = state.filtered[s][0].data();
-    v.filtered[s][1] = state.filtered[s][1].data();
+    for (int k = 0; k < kDenoiseLevels; ++k)
+      v.filtered[s][k] = state.levels[s][in.keepLevels ? std::min(k, levels - 1) : k & 1].data();
     v.historyOut[s] = next.colour[s].data();
   }
   v.out = state.out.data();
+  if (in.reusedFrom) {
+    const EyeState& left = eyes_[int(Eye::Left)];
+    if (eye != Eye::Right || !left.valid || left.keptLevels < params.iterations + 1 || left.signals != signals ||
+        !in.sourceDenoised)
+      throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
+    const History& shared = left.history[left.latest];
+    for (int s = 0; s < signals; ++s) {
+      v.source.history[s] = shared.colour[s].data();
+      for (int k = 0; k <= params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
+    }
+    v.source.moments = shared.moments.data();
+    v.source.length = shared.length.data();
+  }
 
   const dim3 grid(unsigned((camera.width + kBlock - 1) / kBlock), unsigned((camera.height + kBlock - 1) / kBlock));
   const dim3 block(kBlock, kBlock);
-  PVR_CUDA_CHECK(cudaMemsetAsync(historyPixels_.data() + e, 0, sizeof(unsigned), stream));
-  launch("denoise accumulate", accumulateKernel, grid, block, 0, stream, v, historyPixels_.data() + e);
+  uint32_t* list = state.filteredPixels.data();
+  unsigned* count = filteredCount_.data() + e;
+  // The list's length stays on the device: its passes loop over whatever it holds.
+  const unsigned listBlocks = std::min(blocksFor(pixels, kListThreads), unsigned(8 * multiprocessorCount()));
+  PVR_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(unsigned), stream));
+  launch("denoise accumulate", accumulateKernel, grid, block, 0, stream, v, list, count);
   if (params.iterations == 0) {
-    launch("denoise remodulate", remodulateKernel, grid, block, 0, stream, v);
+    launch("denoise remodulate", remodulateKernel, listBlocks, kListThreads, 0, stream, v, list, count);
   } else {
-    launch("denoise variance", varianceKernel, grid, block, 0, stream, v);
-    for (int i = 0; i < params.iterations; ++i) launch("denoise a-trous", atrousKernel, grid, block, 0, stream, v, i);
+    launch("denoise variance", varianceKernel, listBlocks, kListThreads, 0, stream, v, list, count);
+    for (int i = 0; i < params.iterations; ++i)
+      launch("denoise a-trous", atrousKernel, listBlocks, kListThreads, 0, stream, v, i, list, count);
   }
   state.latest ^= 1;
   state.camera = camera;
   state.signals = signals;
+  state.keptLevels = in.keepLevels ? levels : 0;
   state.valid = true;
 }
 
-void GpuDenoiser::downloadHistoryPixels(unsigned host[2], cudaStream_t stream) const {
-  host[0] = host[1] = 0;
-  if (historyPixels_.data())
-    PVR_CUDA_CHECK(cudaMemcpyAsync(host, historyPixels_.data(), 2 * sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
-}
-
 size_t GpuDenoiser::memoryBytes() const {
-  size_t bytes = historyPixels_.bytes();
+  size_t bytes = filteredCount_.bytes();
   for (const EyeState& s : eyes_) {
-    bytes += s.history[0].bytes() + s.history[1].bytes() + s.albedo.bytes() + s.depthGradient.bytes() + s.out.bytes();
-    for (int k = 0; k < 2; ++k) bytes += s.accumulated[k].bytes() + s.filtered[k][0].bytes() + s.filtered[k][1].bytes();
+    bytes += s.history[0].bytes() + s.history[1].bytes() + s.albedo.bytes() + s.depthGradient.bytes() + s.out.bytes() +
+             s.filteredPixels.bytes();
+    for (int k = 0; k < 2; ++k)
+      for (const auto& level : s.levels[k]) bytes += level.bytes();
   }
   return bytes;
 }

@@ -1,5 +1,6 @@
 #include "pvr/denoise/host_denoiser.h"
 
+#include <algorithm>
 #include <atomic>
 
 #include "pvr/util/error.h"
@@ -28,11 +29,10 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
     state.valid = false;
   const History& previous = state.history[state.latest];
   History& next = state.history[state.latest ^ 1];
+  const int levels = in.keepLevels ? params.iterations + 1 : 2;
   for (int s = 0; s < signals; ++s) {
     next.colour[s].resize(pixels);
-    state.accumulated[s].resize(pixels);
-    state.filtered[s][0].resize(pixels);
-    state.filtered[s][1].resize(pixels);
+    for (int k = 0; k < levels; ++k) state.levels[s][k].resize(pixels);
   }
   next.moments.resize(4 * pixels);
   next.length.resize(pixels);
@@ -59,27 +59,45 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   v.moments = next.moments.data();
   v.length = next.length.data();
   for (int s = 0; s < signals; ++s) {
-    v.accumulated[s] = state.accumulated[s].data();
-    v.filtered[s][0] = state.filtered[s][0].data();
-    v.filtered[s][1] = state.filtered[s][1].data();
+    for (int k = 0; k < kDenoiseLevels; ++k) v.filtered[s][k] = state.levels[s][in.keepLevels ? std::min(k, levels - 1) : k & 1].data();
     v.historyOut[s] = next.colour[s].data();
   }
   v.out = out.pixels.data();
+  if (in.reusedFrom) {
+    const EyeState& left = eyes_[int(Eye::Left)];
+    if (eye != Eye::Right || !left.valid || left.keptLevels < params.iterations + 1 || left.signals != signals ||
+        !in.sourceDenoised)
+      throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
+    const History& shared = left.history[left.latest];
+    for (int s = 0; s < signals; ++s) {
+      v.source.history[s] = shared.colour[s].data();
+      for (int k = 0; k <= params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
+    }
+    v.source.moments = shared.moments.data();
+    v.source.length = shared.length.data();
+  }
 
   std::atomic<size_t> used{0};
   forEachPixel("denoise accumulate", camera, [&](int x, int y) {
     if (accumulateDenoisePixel(v, x, y)) used.fetch_add(1, std::memory_order_relaxed);
   });
+  // The later passes run over the pixels the eye filters (svgf.h's filtersPixel).
+  auto forEachFiltered = [&](const char* what, const auto& body) {
+    forEachPixel(what, camera, [&](int x, int y) {
+      if (filtersPixel(v, denoisePixel(camera, x, y))) body(x, y);
+    });
+  };
   if (params.iterations == 0) {
-    forEachPixel("denoise remodulate", camera, [&](int x, int y) { remodulateAccumulated(v, x, y); });
+    forEachFiltered("denoise remodulate", [&](int x, int y) { remodulateAccumulated(v, x, y); });
   } else {
-    forEachPixel("denoise variance", camera, [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
+    forEachFiltered("denoise variance", [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
     for (int i = 0; i < params.iterations; ++i)
-      forEachPixel("denoise a-trous", camera, [&](int x, int y) { atrousDenoisePixel(v, i, x, y); });
+      forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, x, y); });
   }
   state.latest ^= 1;
   state.camera = camera;
   state.signals = signals;
+  state.keptLevels = in.keepLevels ? levels : 0;
   state.valid = true;
   return used;
 }

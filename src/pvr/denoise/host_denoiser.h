@@ -31,7 +31,8 @@ class HostDenoiser {
     EyeCamera camera;
     std::vector<Vec3> albedo;
     std::vector<float> depthGradient;
-    std::vector<ColourVariance> accumulated[2], filtered[2][2];
+    std::vector<ColourVariance> levels[2][kDenoiseLevels];  ///< two (ping-pong) unless keepLevels
+    int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)
   };
   EyeState eyes_[2];
 };

@@ -20,6 +20,10 @@
 // Foveated frames are rebuilt from samples several pixels apart: every step is scaled by the
 // local sample spacing, so the taps land on neighbouring samples as they do on pixels at full
 // resolution. Where no guides exist (foveated eyes give only depth) the signal is the whole image.
+//
+// Steps 3-5 run only over the pixels an eye filters (`filtersPixel`): background has nothing to
+// filter, and under stereo reuse a right pixel that took the left eye's shading shares the left
+// eye's history and filter levels instead of being denoised a second time.
 #include "pvr/camera/stereo_rig.h"
 #include "pvr/denoise/denoise_options.h"
 #include "pvr/stereo/stereo_reuse.h"
@@ -57,14 +61,27 @@ struct DenoiseInputs {
   const float* inverseDepth = nullptr;  ///< required
   const float* sampleSpacing = nullptr; ///< foveated; null: 1
   // The right eye under stereo reuse: per pixel the left pixel it reused (kNotReused: none), and
-  // the left eye's inputs and denoised image there.
+  // the left eye's normals (the reused surface's guide) and denoised image there.
   const uint32_t* reusedFrom = nullptr;
-  const Vec3* sourceImage = nullptr;
-  const Vec3* sourceEmitted = nullptr;
-  const Vec3* sourceDirect = nullptr;
-  const Vec3* sourceAlbedo = nullptr;
   const Vec3* sourceNormal = nullptr;
   const Vec3* sourceDenoised = nullptr;
+  // The left eye under stereo reuse: the right eye will read its filter's levels, so each level
+  // keeps a buffer of its own (else levels two apart share one).
+  bool keepLevels = false;
+};
+
+// The filter's levels per signal: level 0 is the accumulated signal with its variance, level k + 1
+// the output of a-trous pass k.
+constexpr int kDenoiseLevels = kMaxDenoiseIterations + 1;
+
+// What the left eye's denoise of this frame leaves for the right eye under stereo reuse: its new
+// history and every filter level, so that a reused right pixel is denoised once, in the left eye,
+// and a right pixel beside it filters with the left eye's values there.
+struct DenoiseSharedView {
+  const ColourVariance* history[2] = {nullptr, nullptr};
+  const float* moments = nullptr;
+  const float* length = nullptr;
+  const ColourVariance* levels[2][kDenoiseLevels] = {};
 };
 
 // One eye's denoising history: the filtered colours, moments, history length and guides of its
@@ -87,13 +104,15 @@ struct DenoiseFrameView {
   DenoiseHistoryView history;
   Vec3* albedo = nullptr;                          ///< the demodulation albedo used (as remodulated)
   DenoiseGuide* guide = nullptr;                   ///< becomes the history's
-  ColourVariance* accumulated[2] = {nullptr, nullptr};
   float* moments = nullptr;                        ///< becomes the history's
   float* length = nullptr;                         ///< becomes the history's
   float* depthGradient = nullptr;                  ///< 2 per pixel: the inverse depth's gradient (x, y), per pixel
-  ColourVariance* filtered[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};  ///< a-trous ping-pong per signal
+  // Per signal and level (kDenoiseLevels); a backend may let levels two apart share a buffer
+  // (ping-pong) unless a reusing right eye reads them.
+  ColourVariance* filtered[2][kDenoiseLevels] = {};
   ColourVariance* historyOut[2] = {nullptr, nullptr};  ///< the first pass's output: the next frame's history
   Vec3* out = nullptr;                             ///< the denoised image
+  DenoiseSharedView source;                        ///< the left eye's, where in.reusedFrom is set
   PVR_HOST_DEVICE int twoSignals() const { return in.direct ? 2 : 1; }
 };
 
@@ -191,38 +210,78 @@ PVR_HOST_DEVICE inline void inverseDepthGradient(const float* inverseDepth, cons
   gy = centre > 0.0f ? axis(0, 1) : 0.0f;
 }
 
-// The pixel's inputs: demodulated signals, albedo and guide; a reused pixel takes the left eye's.
+// The left pixel a right pixel reused under stereo reuse (kNotReused: none, or not the reusing eye).
+PVR_HOST_DEVICE inline uint32_t reusedSourcePixel(const DenoiseFrameView& v, size_t pixel) {
+  return v.in.reusedFrom ? v.in.reusedFrom[pixel] : kNotReused;
+}
+
+// Whether the eye filters the pixel (steps 3-5): it sees a surface, and one of its own. Background
+// has nothing to filter (it shows what the eye pass rendered: the sky or black); a reused right
+// pixel shares the left eye's denoise.
+PVR_HOST_DEVICE inline bool filtersPixel(const DenoiseFrameView& v, size_t pixel) {
+  return v.in.inverseDepth[pixel] > 0.0f && reusedSourcePixel(v, pixel) == kNotReused;
+}
+
+// Signal s of pixel q at a filter level: the eye's own, or for a reused right pixel the left
+// eye's at the pixel it reused.
+PVR_HOST_DEVICE inline const ColourVariance& levelAt(const DenoiseFrameView& v, int s, int level, size_t q) {
+  const uint32_t source = reusedSourcePixel(v, q);
+  return source == kNotReused ? v.filtered[s][level][q] : v.source.levels[s][level][source];
+}
+
+// The pixel's inputs: demodulated signals, albedo and guide.
 PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t pixel, Vec3 signal[2], Vec3& albedo,
                                               DenoiseGuide& guide) {
   const DenoiseInputs& in = v.in;
-  const uint32_t source = in.reusedFrom ? in.reusedFrom[pixel] : kNotReused;
-  const bool reused = source != kNotReused;
-  const Vec3 image = reused ? in.sourceImage[source] : in.image[pixel];
-  const Vec3* emitted = reused ? in.sourceEmitted : in.emitted;
-  const Vec3* direct = reused ? in.sourceDirect : in.direct;
-  const Vec3* albedos = reused ? in.sourceAlbedo : in.albedo;
-  const Vec3* normals = reused ? in.sourceNormal : in.normal;
-  const size_t at = reused ? size_t(source) : pixel;
-  albedo = albedos ? demodulationAlbedo(albedos[at]) : Vec3(1.0f);
-  if (direct) {
-    const Vec3 d = direct[at], e = emitted ? emitted[at] : Vec3(0.0f);
+  const Vec3 image = in.image[pixel];
+  albedo = in.albedo ? demodulationAlbedo(in.albedo[pixel]) : Vec3(1.0f);
+  if (in.direct) {
+    const Vec3 d = in.direct[pixel], e = in.emitted ? in.emitted[pixel] : Vec3(0.0f);
     signal[0] = divide(max(d - e, Vec3(0.0f)), albedo);
     signal[1] = divide(max(image - d, Vec3(0.0f)), albedo);
   } else {
     signal[0] = divide(image, albedo);
     signal[1] = Vec3(0.0f);
   }
-  guide.normal = normals ? normals[at] : Vec3(0.0f);
+  guide.normal = in.normal ? in.normal[pixel] : Vec3(0.0f);
   guide.inverseDepth = in.inverseDepth[pixel];
 }
 
-// Step 2 at pixel (x, y): the accumulated signals (variance from the moments), moments, history
-// length and the pixel's guide and albedo. Returns whether the history contributed.
+// Step 2 for a pixel the eye does not filter. A reused right pixel takes the left eye's new
+// history at the pixel it reused (so it carries that history on if it is shaded by its own eye
+// next frame) and shows the left eye's denoised colour there: one denoise of that surface, and
+// both eyes agree on it. Background shows the rendered image and keeps no history.
+template <int S>
+PVR_HOST_DEVICE inline bool accumulateUnfilteredPixel(const DenoiseFrameView& v, size_t pixel) {
+  const uint32_t source = reusedSourcePixel(v, pixel);
+  DenoiseGuide guide;
+  guide.inverseDepth = v.in.inverseDepth[pixel];
+  if (source != kNotReused) {
+    guide.normal = v.in.sourceNormal ? v.in.sourceNormal[source] : Vec3(0.0f);
+    v.guide[pixel] = guide;
+    for (int m = 0; m < 4; ++m) v.moments[4 * pixel + m] = v.source.moments[4 * size_t(source) + m];
+    v.length[pixel] = v.source.length[source];
+    for (int s = 0; s < S; ++s) v.historyOut[s][pixel] = v.source.history[s][source];
+    v.out[pixel] = v.in.sourceDenoised[source];
+    return v.length[pixel] > 1.5f;
+  }
+  v.guide[pixel] = guide;
+  for (int m = 0; m < 4; ++m) v.moments[4 * pixel + m] = 0.0f;
+  v.length[pixel] = 0.0f;
+  for (int s = 0; s < S; ++s) v.historyOut[s][pixel] = ColourVariance();
+  v.out[pixel] = v.in.image[pixel];
+  return false;
+}
+
+// Step 2 at pixel (x, y): the accumulated signals (variance from the moments) into level 0,
+// moments, history length and the pixel's guide and albedo. Returns whether the history
+// contributed (for a reused right pixel: whether the left eye's had).
 // Each pass is written for S signals (1 or 2) known at compile time, so that the per-signal arrays
 // stay in registers on the GPU; the untemplated names choose S from the inputs.
 template <int S>
 PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
+  if (!filtersPixel(v, pixel)) return accumulateUnfilteredPixel<S>(v, pixel);
   Vec3 signal[2], albedo;
   DenoiseGuide guide;
   demodulatedInputs(v, pixel, signal, albedo, guide);
@@ -299,51 +358,43 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
     // that falls; a refining history is the plain average, never a filtered one.
     c.variance *= fminf(1.0f, alpha * moving);
     if (refining) v.historyOut[s][pixel] = c;  // else the first a-trous pass (or remodulate) writes it
-    v.accumulated[s][pixel] = c;
+    v.filtered[s][0][pixel] = c;
   }
   return used;
 }
 
-// Step 3 at pixel (x, y): where the history is short, the variance from the moments of a 7x7
-// neighbourhood on the same surface; written into the first a-trous input.
+
+// Step 3 at a pixel the eye filters: where the history is short, the variance of level 0 from the
+// moments of a 7x7 neighbourhood on the same surface, read at every other pixel (offsets -3, -1,
+// 1, 3 on each axis, and the pixel itself: 17 taps, a third of the window's 49, for the frames
+// after a cut or disocclusion, when every pixel of an eye takes this path at once).
 template <int S>
 PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
-  constexpr int signals = S;
-  ColourVariance c[2];
-  for (int s = 0; s < signals; ++s) c[s] = v.accumulated[s][pixel];
-  if (v.length[pixel] < kDenoiseShortHistory) {
-    const DenoiseGuide p = v.guide[pixel];
-    const int step = denoiseSpacing(v, pixel);
-    const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
-    float sum[4] = {0, 0, 0, 0}, total = 0.0f;
-    for (int j = -3; j <= 3; ++j)
-      for (int i = -3; i <= 3; ++i) {
-        const int qx = x + i * step, qy = y + j * step;
-        if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
-        const size_t q = denoisePixel(v.camera, qx, qy);
-        const float w = (i == 0 && j == 0) ? 1.0f : geometryWeight(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params);
-        if (!(w > 0.0f)) continue;
-        for (int m = 0; m < 4; ++m) sum[m] += v.moments[4 * q + m] * w;
-        total += w;
-      }
-    for (int s = 0; s < signals; ++s) {
-      const float mean = sum[2 * s] / total, meanSquare = sum[2 * s + 1] / total;
-      c[s].variance = fmaxf(0.0f, meanSquare - mean * mean);
+  if (!(v.length[pixel] < kDenoiseShortHistory)) return;
+  const DenoiseGuide p = v.guide[pixel];
+  const int step = denoiseSpacing(v, pixel);
+  const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
+  float sum[4], total = 1.0f;
+  for (int m = 0; m < 4; ++m) sum[m] = v.moments[4 * pixel + m];
+  for (int j = -3; j <= 3; j += 2)
+    for (int i = -3; i <= 3; i += 2) {
+      const int qx = x + i * step, qy = y + j * step;
+      if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
+      const size_t q = denoisePixel(v.camera, qx, qy);
+      const float w = geometryWeight(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params);
+      if (!(w > 0.0f)) continue;
+      for (int m = 0; m < 4; ++m) sum[m] += v.moments[4 * q + m] * w;
+      total += w;
     }
+  for (int s = 0; s < S; ++s) {
+    const float mean = sum[2 * s] / total, meanSquare = sum[2 * s + 1] / total;
+    v.filtered[s][0][pixel].variance = fmaxf(0.0f, meanSquare - mean * mean);
   }
-  for (int s = 0; s < signals; ++s) v.filtered[s][0][pixel] = c[s];
 }
 
-// The denoised colour of a pixel: its filtered signals remodulated; under stereo reuse a right
-// pixel that took the left eye's shading shows the left eye's denoised colour there instead (one
-// denoise of that surface, not two, and both eyes agree on it).
+// The denoised colour of a pixel the eye filters: its filtered signals remodulated.
 PVR_HOST_DEVICE inline void writeDenoised(const DenoiseFrameView& v, size_t pixel, Vec3 demodulated) {
-  const uint32_t source = v.in.reusedFrom ? v.in.reusedFrom[pixel] : kNotReused;
-  if (source != kNotReused) {
-    v.out[pixel] = v.in.sourceDenoised[source];
-    return;
-  }
   const Vec3 emitted = v.in.direct && v.in.emitted ? v.in.emitted[pixel] : Vec3(0.0f);
   v.out[pixel] = emitted + demodulated * v.albedo[pixel];
 }
@@ -357,10 +408,10 @@ PVR_HOST_DEVICE inline bool refiningPixel(const DenoiseFrameView& v, size_t pixe
 // passes reach 31 samples across at a third of a 5x5 kernel's taps).
 PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.5f : 0.25f; }
 
-// A 3x3 Gaussian of the variance around the pixel over its own surface (the luminance test's
-// scale, less noisy; a noisier surface beside it does not loosen it).
-PVR_HOST_DEVICE inline float blurredVariance(const ColourVariance* in, const DenoiseFrameView& v, const DenoiseGuide& p,
-                                             float gx, float gy, int x, int y, int step) {
+// A 3x3 Gaussian of level 0's variance of signal s around the pixel over its own surface (the
+// luminance test's scale, less noisy; a noisier surface beside it does not loosen it).
+PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, int s, const DenoiseGuide& p, float gx, float gy,
+                                             int x, int y, int step) {
   float sum = 0.0f, total = 0.0f;
   for (int j = -1; j <= 1; ++j)
     for (int i = -1; i <= 1; ++i) {
@@ -370,19 +421,19 @@ PVR_HOST_DEVICE inline float blurredVariance(const ColourVariance* in, const Den
       float penalty;
       if ((i || j) && !sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, penalty)) continue;
       const float w = (i == 0 ? 0.5f : 0.25f) * (j == 0 ? 0.5f : 0.25f);
-      sum += in[q].variance * w;
+      sum += levelAt(v, s, 0, q).variance * w;
       total += w;
     }
   return sum / total;
 }
 
-// Step 4, a-trous pass `iteration` at pixel (x, y): reads filtered[s][iteration & 1], writes the
-// other one (and the history after the first pass); the last pass remodulates into `out`.
+// Step 4, a-trous pass `iteration` at a pixel the eye filters: reads level `iteration`, writes the
+// next (and the history after the first pass); the last pass remodulates into `out`.
 template <int S>
 PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int iteration, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   constexpr int signals = S;
-  const int from = iteration & 1, to = from ^ 1;
+  const int from = iteration, to = iteration + 1;
   const DenoiseGuide p = v.guide[pixel];
   const int spacing = denoiseSpacing(v, pixel);
   const int step = spacing << iteration;
@@ -393,7 +444,7 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
     centre[s] = v.filtered[s][from][pixel];
     // The first pass's variance is the noisy estimate of one frame's moments: blurred over the
     // surface first. The later passes' have been filtered by the earlier passes already.
-    centreVariance[s] = iteration == 0 ? blurredVariance(v.filtered[s][from], v, p, gx, gy, x, y, spacing) : centre[s].variance;
+    centreVariance[s] = iteration == 0 ? blurredVariance(v, s, p, gx, gy, x, y, spacing) : centre[s].variance;
   }
   Vec3 sum[2] = {Vec3(0.0f), Vec3(0.0f)};
   float variance[2] = {0, 0}, total[2] = {0, 0};
@@ -409,7 +460,7 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
       if (!self && !sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, geometry)) continue;
       const float kernel = atrousKernel(i) * atrousKernel(j);
       for (int s = 0; s < signals; ++s) {
-        const ColourVariance c = self ? centre[s] : v.filtered[s][from][q];
+        const ColourVariance c = self ? centre[s] : levelAt(v, s, from, q);
         // The larger of the two variances scales the luminance test, so that two pixels weigh each
         // other alike: a dark pixel whose few samples happened to agree (a small variance) still
         // takes its bright neighbours' light, as they take its darkness, and the mean stays.
@@ -433,14 +484,14 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
   }
 }
 
-// Step 5 without a-trous passes (iterations 0): the accumulated signals remodulated, and kept as
-// the history.
+// Step 5 without a-trous passes (iterations 0), at a pixel the eye filters: level 0 remodulated,
+// and kept as the history.
 template <int S>
 PVR_HOST_DEVICE inline void remodulateAccumulatedOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   Vec3 radiance{0, 0, 0};
   for (int s = 0; s < S; ++s) {
-    const ColourVariance c = v.accumulated[s][pixel];
+    const ColourVariance c = v.filtered[s][0][pixel];
     v.historyOut[s][pixel] = c;
     radiance += c.colour;
   }
