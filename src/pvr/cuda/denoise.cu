@@ -16,27 +16,34 @@ __device__ inline bool blockPixel(const EyeCamera& c, int& x, int& y) {
   return x < c.width && y < c.height;
 }
 
-// Appends `value` to list[*count] for each thread of the warp whose flag is set, one atomic per
-// warp: a warp's pixels (two rows of 16 neighbours) stay together, so the later passes' taps are
-// as coherent as over the whole image.
-__device__ inline void appendInWarp(uint32_t* list, unsigned* count, bool flag, uint32_t value) {
-  const unsigned active = __activemask();
-  const unsigned set = __ballot_sync(active, flag);
-  if (!set) return;
-  const unsigned lane = (threadIdx.y * blockDim.x + threadIdx.x) & 31u;
-  const unsigned leader = unsigned(__ffs(int(set)) - 1);
-  unsigned base = 0;
-  if (lane == leader) base = atomicAdd(count, unsigned(__popc(int(set))));
-  base = __shfl_sync(active, base, int(leader));
-  if (flag) list[base + unsigned(__popc(int(set & ((1u << lane) - 1u))))] = value;
+// Appends the pixel to list[*count] where `flag` is set, one atomic per block: a block's pixels
+// (a 16x16 tile) stay together and in order, so a block of the later passes reads the same tile's
+// neighbourhood as a block over the whole image would.
+__device__ inline void appendInBlock(uint32_t* list, unsigned* count, bool flag, uint32_t pixel) {
+  constexpr int kWarps = kBlock * kBlock / 32;
+  __shared__ unsigned warpStart[kWarps + 1];
+  const unsigned thread = threadIdx.y * blockDim.x + threadIdx.x, warp = thread / 32, lane = thread % 32;
+  const unsigned set = __ballot_sync(0xffffffffu, flag);
+  if (lane == 0) warpStart[warp + 1] = unsigned(__popc(int(set)));
+  __syncthreads();
+  if (thread == 0) {
+    warpStart[0] = 0;
+    for (int w = 1; w <= kWarps; ++w) warpStart[w] += warpStart[w - 1];
+    const unsigned total = warpStart[kWarps];
+    // The block's first slot, kept in the last entry's place once the sum is read.
+    warpStart[kWarps] = total ? atomicAdd(count, total) : 0u;
+  }
+  __syncthreads();
+  if (flag) list[warpStart[kWarps] + warpStart[warp] + unsigned(__popc(int(set & ((1u << lane) - 1u))))] = pixel;
 }
 
-__global__ void accumulateKernel(DenoiseFrameView v, uint32_t* filtered, unsigned* filteredCount) {
+__global__ void __launch_bounds__(kBlock * kBlock) accumulateKernel(DenoiseFrameView v, uint32_t* filtered,
+                                                                     unsigned* filteredCount) {
   int x, y;
   const bool inside = blockPixel(v.camera, x, y);
   const size_t pixel = inside ? denoisePixel(v.camera, x, y) : 0;
   if (inside) accumulateDenoisePixel(v, x, y);
-  appendInWarp(filtered, filteredCount, inside && filtersPixel(v, pixel), uint32_t(pixel));
+  appendInBlock(filtered, filteredCount, inside && filtersPixel(v, pixel), uint32_t(pixel));
 }
 
 // The later passes: a grid-stride loop over the listed pixels.
@@ -53,8 +60,18 @@ __global__ void varianceKernel(DenoiseFrameView v, const uint32_t* pixels, const
   forEachListed(v, pixels, count, [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
 }
 
-__global__ void atrousKernel(DenoiseFrameView v, int iteration, const uint32_t* pixels, const unsigned* count) {
-  forEachListed(v, pixels, count, [&](int x, int y) { atrousDenoisePixel(v, iteration, x, y); });
+// At most 64 registers: four blocks of 256 threads per SM (at 75 it held three).
+__global__ void __launch_bounds__(kListThreads, 4)
+    atrousKernel(DenoiseFrameView v, int iteration, AtrousLevels levels, const uint32_t* pixels, const unsigned* count) {
+  forEachListed(v, pixels, count, [&](int x, int y) { atrousDenoisePixel(v, iteration, levels, x, y); });
+}
+
+// Blocks of a grid-stride kernel that fill every SM once (no partial last wave).
+template <class Kernel>
+unsigned residentBlocks(Kernel kernel, size_t items) {
+  int perSm = 0;
+  PVR_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perSm, kernel, int(kListThreads), 0));
+  return std::max(1u, std::min(blocksFor(items, kListThreads), unsigned(std::max(perSm, 1) * multiprocessorCount())));
 }
 
 __global__ void remodulateKernel(DenoiseFrameView v, const uint32_t* pixels, const unsigned* count) {
@@ -129,15 +146,17 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   uint32_t* list = state.filteredPixels.data();
   unsigned* count = filteredCount_.data() + e;
   // The list's length stays on the device: its passes loop over whatever it holds.
-  const unsigned listBlocks = std::min(blocksFor(pixels, kListThreads), unsigned(8 * multiprocessorCount()));
   PVR_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(unsigned), stream));
   launch("denoise accumulate", accumulateKernel, grid, block, 0, stream, v, list, count);
   if (params.iterations == 0) {
-    launch("denoise remodulate", remodulateKernel, listBlocks, kListThreads, 0, stream, v, list, count);
+    launch("denoise remodulate", remodulateKernel, residentBlocks(remodulateKernel, pixels), kListThreads, 0, stream, v,
+           list, count);
   } else {
-    launch("denoise variance", varianceKernel, listBlocks, kListThreads, 0, stream, v, list, count);
+    launch("denoise variance", varianceKernel, residentBlocks(varianceKernel, pixels), kListThreads, 0, stream, v, list,
+           count);
+    const unsigned atrousBlocks = residentBlocks(atrousKernel, pixels);
     for (int i = 0; i < params.iterations; ++i)
-      launch("denoise a-trous", atrousKernel, listBlocks, kListThreads, 0, stream, v, i, list, count);
+      launch("denoise a-trous", atrousKernel, atrousBlocks, kListThreads, 0, stream, v, i, atrousLevels(v, i), list, count);
   }
   state.latest ^= 1;
   state.camera = camera;

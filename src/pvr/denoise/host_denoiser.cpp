@@ -91,8 +91,10 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
     forEachFiltered("denoise remodulate", [&](int x, int y) { remodulateAccumulated(v, x, y); });
   } else {
     forEachFiltered("denoise variance", [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
-    for (int i = 0; i < params.iterations; ++i)
-      forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, x, y); });
+    for (int i = 0; i < params.iterations; ++i) {
+      const AtrousLevels levels = atrousLevels(v, i);
+      forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, levels, x, y); });
+    }
   }
   state.latest ^= 1;
   state.camera = camera;

@@ -116,7 +116,9 @@ struct DenoiseFrameView {
   PVR_HOST_DEVICE int twoSignals() const { return in.direct ? 2 : 1; }
 };
 
-PVR_HOST_DEVICE inline size_t denoisePixel(const EyeCamera& c, int x, int y) { return size_t(y) * c.width + x; }
+// A pixel's index in an eye's buffers (32 bits: an eye holds fewer than 2^32 pixels, and the
+// a-trous pass's taps keep one register per index instead of two).
+PVR_HOST_DEVICE inline uint32_t denoisePixel(const EyeCamera& c, int x, int y) { return uint32_t(y) * uint32_t(c.width) + uint32_t(x); }
 
 // The filter's exponentials and logarithms: the GPU's fast intrinsics (a few ulp from the host's,
 // far below what the weights need).
@@ -222,11 +224,28 @@ PVR_HOST_DEVICE inline bool filtersPixel(const DenoiseFrameView& v, size_t pixel
   return v.in.inverseDepth[pixel] > 0.0f && reusedSourcePixel(v, pixel) == kNotReused;
 }
 
-// Signal s of pixel q at a filter level: the eye's own, or for a reused right pixel the left
-// eye's at the pixel it reused.
-PVR_HOST_DEVICE inline const ColourVariance& levelAt(const DenoiseFrameView& v, int s, int level, size_t q) {
+// What one a-trous pass reads and writes, per signal: the eye's own level, the left eye's same
+// level for reused right pixels, and the next level.
+struct AtrousLevels {
+  const ColourVariance* in[2] = {nullptr, nullptr};
+  const ColourVariance* sourceIn[2] = {nullptr, nullptr};
+  ColourVariance* out[2] = {nullptr, nullptr};
+};
+PVR_HOST_DEVICE inline AtrousLevels atrousLevels(const DenoiseFrameView& v, int iteration) {
+  AtrousLevels l;
+  for (int s = 0; s < 2; ++s) {
+    l.in[s] = v.filtered[s][iteration];
+    l.sourceIn[s] = v.source.levels[s][iteration];
+    l.out[s] = v.filtered[s][iteration + 1];
+  }
+  return l;
+}
+
+// Signal s of pixel q at the pass's input level: the eye's own, or for a reused right pixel the
+// left eye's at the pixel it reused.
+PVR_HOST_DEVICE inline const ColourVariance& levelAt(const DenoiseFrameView& v, const AtrousLevels& l, int s, size_t q) {
   const uint32_t source = reusedSourcePixel(v, q);
-  return source == kNotReused ? v.filtered[s][level][q] : v.source.levels[s][level][source];
+  return source == kNotReused ? l.in[s][q] : l.sourceIn[s][source];
 }
 
 // The pixel's inputs: demodulated signals, albedo and guide.
@@ -410,8 +429,8 @@ PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.5f : 0.25f;
 
 // A 3x3 Gaussian of level 0's variance of signal s around the pixel over its own surface (the
 // luminance test's scale, less noisy; a noisier surface beside it does not loosen it).
-PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, int s, const DenoiseGuide& p, float gx, float gy,
-                                             int x, int y, int step) {
+PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, const AtrousLevels& l, int s,
+                                             const DenoiseGuide& p, float gx, float gy, int x, int y, int step) {
   float sum = 0.0f, total = 0.0f;
   for (int j = -1; j <= 1; ++j)
     for (int i = -1; i <= 1; ++i) {
@@ -421,60 +440,75 @@ PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, int s, c
       float penalty;
       if ((i || j) && !sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, penalty)) continue;
       const float w = (i == 0 ? 0.5f : 0.25f) * (j == 0 ? 0.5f : 0.25f);
-      sum += levelAt(v, s, 0, q).variance * w;
+      sum += levelAt(v, l, s, q).variance * w;
       total += w;
     }
   return sum / total;
 }
 
 // Step 4, a-trous pass `iteration` at a pixel the eye filters: reads level `iteration`, writes the
-// next (and the history after the first pass); the last pass remodulates into `out`.
+// next (and the history after the first pass); the last pass remodulates into `out`. `l` is
+// atrousLevels(v, iteration).
 template <int S>
-PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int iteration, int x, int y) {
+PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int iteration, const AtrousLevels& l, int x,
+                                                 int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   constexpr int signals = S;
-  const int from = iteration, to = iteration + 1;
   const DenoiseGuide p = v.guide[pixel];
   const int spacing = denoiseSpacing(v, pixel);
   const int step = spacing << iteration;
   const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
-  ColourVariance centre[2], result[2];
-  float centreVariance[2];
+  // The pixel's own tap first (kernel weight 1/2 x 1/2); then only its luminance and the
+  // variance that scales the luminance test are needed.
+  const float centreKernel = atrousKernel(0) * atrousKernel(0);
+  Vec3 sum[2];
+  float variance[2], total[2], lp[2], centreVariance[2];
+#ifdef __CUDA_ARCH__
+#pragma unroll
+#endif
   for (int s = 0; s < signals; ++s) {
-    centre[s] = v.filtered[s][from][pixel];
+    const ColourVariance centre = l.in[s][pixel];
+    sum[s] = centre.colour * centreKernel;
+    variance[s] = centre.variance * centreKernel * centreKernel;
+    total[s] = centreKernel;
+    lp[s] = luminance(centre.colour);
     // The first pass's variance is the noisy estimate of one frame's moments: blurred over the
     // surface first. The later passes' have been filtered by the earlier passes already.
-    centreVariance[s] = iteration == 0 ? blurredVariance(v, s, p, gx, gy, x, y, spacing) : centre[s].variance;
+    centreVariance[s] = iteration == 0 ? blurredVariance(v, l, s, p, gx, gy, x, y, spacing) : centre.variance;
   }
-  Vec3 sum[2] = {Vec3(0.0f), Vec3(0.0f)};
-  float variance[2] = {0, 0}, total[2] = {0, 0};
-  const float lp[2] = {luminance(centre[0].colour), luminance(centre[1].colour)};
   const float sigma2 = v.params.sigmaLuminance * v.params.sigmaLuminance;
   for (int j = -1; j <= 1; ++j)
     for (int i = -1; i <= 1; ++i) {
+      if (i == 0 && j == 0) continue;
       const int qx = x + i * step, qy = y + j * step;
       if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
       const size_t q = denoisePixel(v.camera, qx, qy);
-      const bool self = i == 0 && j == 0;
       float geometry = 0.0f;
-      if (!self && !sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, geometry)) continue;
+      if (!sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, geometry)) continue;
       const float kernel = atrousKernel(i) * atrousKernel(j);
+#ifdef __CUDA_ARCH__
+#pragma unroll
+#endif
       for (int s = 0; s < signals; ++s) {
-        const ColourVariance c = self ? centre[s] : levelAt(v, s, from, q);
+        const ColourVariance c = levelAt(v, l, s, q);
         // The larger of the two variances scales the luminance test, so that two pixels weigh each
         // other alike: a dark pixel whose few samples happened to agree (a small variance) still
         // takes its bright neighbours' light, as they take its darkness, and the mean stays.
         const float inverseScale = filterRsqrt(sigma2 * fmaxf(centreVariance[s], c.variance) + 1e-12f);
-        const float w = self ? kernel : kernel * filterExp(-geometry - fabsf(luminance(c.colour) - lp[s]) * inverseScale);
+        const float w = kernel * filterExp(-geometry - fabsf(luminance(c.colour) - lp[s]) * inverseScale);
         sum[s] += c.colour * w;
         variance[s] += c.variance * w * w;
         total[s] += w;
       }
     }
+  ColourVariance result[2];
+#ifdef __CUDA_ARCH__
+#pragma unroll
+#endif
   for (int s = 0; s < signals; ++s) {
     result[s].colour = sum[s] / total[s];
     result[s].variance = variance[s] / (total[s] * total[s]);
-    v.filtered[s][to][pixel] = result[s];
+    l.out[s][pixel] = result[s];
     if (iteration == 0 && !refiningPixel(v, pixel)) v.historyOut[s][pixel] = result[s];
   }
   if (iteration == v.params.iterations - 1) {
@@ -505,9 +539,10 @@ PVR_HOST_DEVICE inline void estimateDenoiseVariance(const DenoiseFrameView& v, i
   if (v.twoSignals() == 2) estimateDenoiseVarianceOf<2>(v, x, y);
   else estimateDenoiseVarianceOf<1>(v, x, y);
 }
-PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int iteration, int x, int y) {
-  if (v.twoSignals() == 2) atrousDenoisePixelOf<2>(v, iteration, x, y);
-  else atrousDenoisePixelOf<1>(v, iteration, x, y);
+PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int iteration, const AtrousLevels& l, int x,
+                                               int y) {
+  if (v.twoSignals() == 2) atrousDenoisePixelOf<2>(v, iteration, l, x, y);
+  else atrousDenoisePixelOf<1>(v, iteration, l, x, y);
 }
 PVR_HOST_DEVICE inline void remodulateAccumulated(const DenoiseFrameView& v, int x, int y) {
   if (v.twoSignals() == 2) remodulateAccumulatedOf<2>(v, x, y);
