@@ -93,7 +93,14 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   const int levels = in.keepLevels ? params.iterations + 1 : 2;
   for (int s = 0; s < signals; ++s) {
     next.colour[s].reserve(pixels, "denoiser history");
-    for (int k = 0; k < levels; ++k) state.levels[s][k].reserve(pixels, "denoiser filter levels");
+    for (int k = 0; k < levels; ++k) {
+      // Cleared when allocated: the a-trous taps read a neighbour's values before testing its
+      // guide, also where no pass writes them (background), and leave them unused there.
+      DeviceBuffer<ColourVariance>& level = state.levels[s][k];
+      if (level.capacity() >= pixels) continue;
+      level.reserve(pixels, "denoiser filter levels");
+      PVR_CUDA_CHECK(cudaMemsetAsync(level.data(), 0, pixels * sizeof(ColourVariance), stream));
+    }
   }
   next.moments.reserve(4 * pixels, "denoiser moments");
   next.length.reserve(pixels, "denoiser history length");

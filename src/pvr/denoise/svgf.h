@@ -33,8 +33,10 @@ namespace pvr {
 
 // Normals closer than this (cosine, 26 degrees) may belong to one surface; farther, never blend.
 constexpr float kDenoiseMinNormalCosine = 0.9f;
-// History is short (the variance comes from the neighbourhood) below this many frames.
-constexpr float kDenoiseShortHistory = 4.0f;
+// History is short (the variance comes from the neighbourhood) below 4 frames. The bound sits a
+// hair under 4: a history read through bilinear taps of 3-frame pixels comes to 3.9999..., which
+// would send a whole moving eye down the neighbourhood's path in its fourth frame.
+constexpr float kDenoiseShortHistory = 3.999f;
 // Frames a history counts at most (refinement averages this many still frames).
 constexpr float kDenoiseMaxHistory = 65535.0f;
 
@@ -269,7 +271,8 @@ PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t 
 // Step 2 for a pixel the eye does not filter. A reused right pixel takes the left eye's new
 // history at the pixel it reused (so it carries that history on if it is shaded by its own eye
 // next frame) and shows the left eye's denoised colour there: one denoise of that surface, and
-// both eyes agree on it. Background shows the rendered image and keeps no history.
+// both eyes agree on it. Background shows the rendered image and keeps no history (only its
+// guide, which no surface's reprojection or neighbourhood accepts).
 template <int S>
 PVR_HOST_DEVICE inline bool accumulateUnfilteredPixel(const DenoiseFrameView& v, size_t pixel) {
   const uint32_t source = reusedSourcePixel(v, pixel);
@@ -284,10 +287,8 @@ PVR_HOST_DEVICE inline bool accumulateUnfilteredPixel(const DenoiseFrameView& v,
     v.out[pixel] = v.in.sourceDenoised[source];
     return v.length[pixel] > 1.5f;
   }
+  // Background: its guide turns away every later read of its history (no surface meets it).
   v.guide[pixel] = guide;
-  for (int m = 0; m < 4; ++m) v.moments[4 * pixel + m] = 0.0f;
-  v.length[pixel] = 0.0f;
-  for (int s = 0; s < S; ++s) v.historyOut[s][pixel] = ColourVariance();
   v.out[pixel] = v.in.image[pixel];
   return false;
 }
@@ -483,14 +484,22 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
       const int qx = x + i * step, qy = y + j * step;
       if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
       const size_t q = denoisePixel(v.camera, qx, qy);
+      // The tap's guide and values are read together, before the guide is tested: one trip to
+      // memory per tap, not two (a rejected tap's values are read and left unused).
+      const DenoiseGuide g = v.guide[q];
+      ColourVariance values[2];
+#ifdef __CUDA_ARCH__
+#pragma unroll
+#endif
+      for (int s = 0; s < signals; ++s) values[s] = levelAt(v, l, s, q);
       float geometry = 0.0f;
-      if (!sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, geometry)) continue;
+      if (!sameSurface(p, g, gx, gy, float(i * step), float(j * step), v.params, geometry)) continue;
       const float kernel = atrousKernel(i) * atrousKernel(j);
 #ifdef __CUDA_ARCH__
 #pragma unroll
 #endif
       for (int s = 0; s < signals; ++s) {
-        const ColourVariance c = levelAt(v, l, s, q);
+        const ColourVariance& c = values[s];
         // The larger of the two variances scales the luminance test, so that two pixels weigh each
         // other alike: a dark pixel whose few samples happened to agree (a small variance) still
         // takes its bright neighbours' light, as they take its darkness, and the mean stays.
