@@ -66,6 +66,56 @@ __global__ void __launch_bounds__(kListThreads, 4)
   forEachListed(v, pixels, count, [&](int x, int y) { atrousDenoisePixel(v, iteration, levels, x, y); });
 }
 
+// A full-resolution eye's a-trous pass by tiles. At step s the image splits into s x s lattices of
+// pixels s apart (one per offset); a block takes a 16x16 tile of one lattice, whose 3x3 taps all
+// lie on that lattice, loads the tile and its one-sample rim into shared memory together (every
+// load in flight at once, instead of each tap's waiting in turn), and filters the tile's pixels
+// from there. Consecutive blocks take the lattices of one image region, which share cache lines.
+constexpr int kTile = kBlock, kTileRim = kTile + 2;
+
+template <int S>
+struct TileTaps {
+  const DenoiseGuide (*guides)[kTileRim];
+  const ColourVariance (*values)[kTileRim][kTileRim];
+  int tx, ty;  ///< the pixel's place in the tile (the rim excluded)
+  __device__ DenoiseGuide guide(int i, int j, size_t) const { return guides[ty + 1 + j][tx + 1 + i]; }
+  __device__ ColourVariance value(int s, int i, int j, size_t) const { return values[s][ty + 1 + j][tx + 1 + i]; }
+};
+
+// The tile's lattice for a block: its offset in the image (ox, oy) and the tile's first lattice point.
+struct LatticeTile {
+  int ox, oy, lx0, ly0;
+};
+__device__ inline LatticeTile latticeTile(int step, int tilesX) {
+  const int lattices = step * step;
+  const int tile = int(blockIdx.x) / lattices, offset = int(blockIdx.x) % lattices;
+  return {offset % step, offset / step, (tile % tilesX) * kTile, (tile / tilesX) * kTile};
+}
+
+template <int S>
+__global__ void __launch_bounds__(kTile * kTile, 4)
+    atrousTileKernel(DenoiseFrameView v, int iteration, AtrousLevels levels, int tilesX) {
+  __shared__ DenoiseGuide guides[kTileRim][kTileRim];
+  __shared__ ColourVariance values[S][kTileRim][kTileRim];
+  const int step = 1 << iteration;  // full resolution: a spacing of 1
+  const LatticeTile t = latticeTile(step, tilesX);
+  const int x = t.ox + (t.lx0 + int(threadIdx.x)) * step, y = t.oy + (t.ly0 + int(threadIdx.y)) * step;
+  const bool inside = x < v.camera.width && y < v.camera.height;
+  const bool mine = inside && filtersPixel(v, denoisePixel(v.camera, x, y));
+  if (!__syncthreads_or(mine)) return;  // nothing to filter here (background)
+  const MemoryTaps memory{v, levels};
+  for (int e = int(threadIdx.y * kTile + threadIdx.x); e < kTileRim * kTileRim; e += kTile * kTile) {
+    const int ex = e % kTileRim, ey = e / kTileRim;
+    const int qx = t.ox + (t.lx0 + ex - 1) * step, qy = t.oy + (t.ly0 + ey - 1) * step;
+    if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;  // never read
+    const size_t q = denoisePixel(v.camera, qx, qy);
+    guides[ey][ex] = v.guide[q];
+    for (int s = 0; s < S; ++s) values[s][ey][ex] = memory.value(s, 0, 0, q);
+  }
+  __syncthreads();
+  if (mine) atrousDenoisePixelOf<S>(v, iteration, levels, TileTaps<S>{guides, values, int(threadIdx.x), int(threadIdx.y)}, x, y);
+}
+
 // Blocks of a grid-stride kernel that fill every SM once (no partial last wave).
 template <class Kernel>
 unsigned residentBlocks(Kernel kernel, size_t items) {
@@ -161,9 +211,22 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   } else {
     launch("denoise variance", varianceKernel, residentBlocks(varianceKernel, pixels), kListThreads, 0, stream, v, list,
            count);
+    // A full-resolution eye of its own filters by tiles; a foveated one (taps at each sample's
+    // spacing) and a reusing right eye (a few pixels) over the list.
+    const bool tiles = !in.sampleSpacing && !in.reusedFrom;
     const unsigned atrousBlocks = residentBlocks(atrousKernel, pixels);
-    for (int i = 0; i < params.iterations; ++i)
-      launch("denoise a-trous", atrousKernel, atrousBlocks, kListThreads, 0, stream, v, i, atrousLevels(v, i), list, count);
+    for (int i = 0; i < params.iterations; ++i) {
+      const AtrousLevels levels = atrousLevels(v, i);
+      if (!tiles) {
+        launch("denoise a-trous", atrousKernel, atrousBlocks, kListThreads, 0, stream, v, i, levels, list, count);
+        continue;
+      }
+      const int step = 1 << i, tilesX = (camera.width + step * kTile - 1) / (step * kTile);
+      const int tilesY = (camera.height + step * kTile - 1) / (step * kTile);
+      const unsigned blocks = unsigned(step * step * tilesX * tilesY);
+      if (signals == 2) launch("denoise a-trous", atrousTileKernel<2>, blocks, block, 0, stream, v, i, levels, tilesX);
+      else launch("denoise a-trous", atrousTileKernel<1>, blocks, block, 0, stream, v, i, levels, tilesX);
+    }
   }
   state.latest ^= 1;
   state.camera = camera;

@@ -428,10 +428,22 @@ PVR_HOST_DEVICE inline bool refiningPixel(const DenoiseFrameView& v, size_t pixe
 // passes reach 31 samples across at a third of a 5x5 kernel's taps).
 PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.5f : 0.25f; }
 
+// Where an a-trous pass reads the pixel's 3x3 taps (offsets (i, j) in -1..1 of its step; q the
+// tap's pixel): the eye's buffers, as here (the CPU, and the GPU's listed pixels), or a GPU
+// block's tile of them in shared memory (cuda/denoise.cu).
+struct MemoryTaps {
+  const DenoiseFrameView& v;
+  const AtrousLevels& l;
+  PVR_HOST_DEVICE DenoiseGuide guide(int, int, size_t q) const { return v.guide[q]; }
+  PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const { return levelAt(v, l, s, q); }
+};
+
 // A 3x3 Gaussian of level 0's variance of signal s around the pixel over its own surface (the
-// luminance test's scale, less noisy; a noisier surface beside it does not loosen it).
-PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, const AtrousLevels& l, int s,
-                                             const DenoiseGuide& p, float gx, float gy, int x, int y, int step) {
+// luminance test's scale, less noisy; a noisier surface beside it does not loosen it). Its taps are
+// the first pass's.
+template <class Taps>
+PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, const Taps& taps, int s, const DenoiseGuide& p,
+                                             float gx, float gy, int x, int y, int step) {
   float sum = 0.0f, total = 0.0f;
   for (int j = -1; j <= 1; ++j)
     for (int i = -1; i <= 1; ++i) {
@@ -439,9 +451,10 @@ PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, const At
       if (qx < 0 || qy < 0 || qx >= v.camera.width || qy >= v.camera.height) continue;
       const size_t q = denoisePixel(v.camera, qx, qy);
       float penalty;
-      if ((i || j) && !sameSurface(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params, penalty)) continue;
+      if ((i || j) && !sameSurface(p, taps.guide(i, j, q), gx, gy, float(i * step), float(j * step), v.params, penalty))
+        continue;
       const float w = (i == 0 ? 0.5f : 0.25f) * (j == 0 ? 0.5f : 0.25f);
-      sum += levelAt(v, l, s, q).variance * w;
+      sum += taps.value(s, i, j, q).variance * w;
       total += w;
     }
   return sum / total;
@@ -449,13 +462,13 @@ PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, const At
 
 // Step 4, a-trous pass `iteration` at a pixel the eye filters: reads level `iteration`, writes the
 // next (and the history after the first pass); the last pass remodulates into `out`. `l` is
-// atrousLevels(v, iteration).
-template <int S>
-PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int iteration, const AtrousLevels& l, int x,
-                                                 int y) {
+// atrousLevels(v, iteration); `taps` reads the level's values (MemoryTaps, or a GPU tile).
+template <int S, class Taps>
+PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int iteration, const AtrousLevels& l,
+                                                 const Taps& taps, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   constexpr int signals = S;
-  const DenoiseGuide p = v.guide[pixel];
+  const DenoiseGuide p = taps.guide(0, 0, pixel);
   const int spacing = denoiseSpacing(v, pixel);
   const int step = spacing << iteration;
   const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
@@ -468,14 +481,14 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
 #pragma unroll
 #endif
   for (int s = 0; s < signals; ++s) {
-    const ColourVariance centre = l.in[s][pixel];
+    const ColourVariance centre = taps.value(s, 0, 0, pixel);
     sum[s] = centre.colour * centreKernel;
     variance[s] = centre.variance * centreKernel * centreKernel;
     total[s] = centreKernel;
     lp[s] = luminance(centre.colour);
     // The first pass's variance is the noisy estimate of one frame's moments: blurred over the
     // surface first. The later passes' have been filtered by the earlier passes already.
-    centreVariance[s] = iteration == 0 ? blurredVariance(v, l, s, p, gx, gy, x, y, spacing) : centre.variance;
+    centreVariance[s] = iteration == 0 ? blurredVariance(v, taps, s, p, gx, gy, x, y, spacing) : centre.variance;
   }
   const float sigma2 = v.params.sigmaLuminance * v.params.sigmaLuminance;
   for (int j = -1; j <= 1; ++j)
@@ -486,12 +499,12 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
       const size_t q = denoisePixel(v.camera, qx, qy);
       // The tap's guide and values are read together, before the guide is tested: one trip to
       // memory per tap, not two (a rejected tap's values are read and left unused).
-      const DenoiseGuide g = v.guide[q];
+      const DenoiseGuide g = taps.guide(i, j, q);
       ColourVariance values[2];
 #ifdef __CUDA_ARCH__
 #pragma unroll
 #endif
-      for (int s = 0; s < signals; ++s) values[s] = levelAt(v, l, s, q);
+      for (int s = 0; s < signals; ++s) values[s] = taps.value(s, i, j, q);
       float geometry = 0.0f;
       if (!sameSurface(p, g, gx, gy, float(i * step), float(j * step), v.params, geometry)) continue;
       const float kernel = atrousKernel(i) * atrousKernel(j);
@@ -550,8 +563,9 @@ PVR_HOST_DEVICE inline void estimateDenoiseVariance(const DenoiseFrameView& v, i
 }
 PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int iteration, const AtrousLevels& l, int x,
                                                int y) {
-  if (v.twoSignals() == 2) atrousDenoisePixelOf<2>(v, iteration, l, x, y);
-  else atrousDenoisePixelOf<1>(v, iteration, l, x, y);
+  const MemoryTaps taps{v, l};
+  if (v.twoSignals() == 2) atrousDenoisePixelOf<2>(v, iteration, l, taps, x, y);
+  else atrousDenoisePixelOf<1>(v, iteration, l, taps, x, y);
 }
 PVR_HOST_DEVICE inline void remodulateAccumulated(const DenoiseFrameView& v, int x, int y) {
   if (v.twoSignals() == 2) remodulateAccumulatedOf<2>(v, x, y);
