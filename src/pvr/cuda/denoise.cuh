@@ -31,7 +31,7 @@ class GpuDenoiser {
     int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)
     bool valid = false;
     EyeCamera camera;
-    DeviceBuffer<Vec3> albedo, out;
+    DeviceBuffer<Vec3> out;
     DeviceBuffer<float> depthGradient;
     DeviceBuffer<ColourVariance> levels[2][kDenoiseLevels];  ///< two (ping-pong) unless keepLevels
     DeviceBuffer<uint32_t> filteredPixels;                   ///< the pixels the eye filters, in warps of neighbours

@@ -37,7 +37,6 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   next.moments.resize(4 * pixels);
   next.length.resize(pixels);
   next.guide.resize(pixels);
-  state.albedo.resize(pixels);
   state.depthGradient.resize(2 * pixels);
   out = Image(camera.width, camera.height);
 
@@ -53,7 +52,6 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
     v.history.length = previous.length.data();
     v.history.guide = previous.guide.data();
   }
-  v.albedo = state.albedo.data();
   v.depthGradient = state.depthGradient.data();
   v.guide = next.guide.data();
   v.moments = next.moments.data();

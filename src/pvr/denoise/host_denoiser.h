@@ -29,7 +29,6 @@ class HostDenoiser {
     int latest = 0, signals = 0;
     bool valid = false;
     EyeCamera camera;
-    std::vector<Vec3> albedo;
     std::vector<float> depthGradient;
     std::vector<ColourVariance> levels[2][kDenoiseLevels];  ///< two (ping-pong) unless keepLevels
     int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)

@@ -104,7 +104,6 @@ struct DenoiseFrameView {
   DenoiseParams params;
   int stillFrames = 0;  ///< frames the view has been still before this one (0: moving; refinement)
   DenoiseHistoryView history;
-  Vec3* albedo = nullptr;                          ///< the demodulation albedo used (as remodulated)
   DenoiseGuide* guide = nullptr;                   ///< becomes the history's
   float* moments = nullptr;                        ///< becomes the history's
   float* length = nullptr;                         ///< becomes the history's
@@ -294,7 +293,7 @@ PVR_HOST_DEVICE inline bool accumulateUnfilteredPixel(const DenoiseFrameView& v,
 }
 
 // Step 2 at pixel (x, y): the accumulated signals (variance from the moments) into level 0,
-// moments, history length and the pixel's guide and albedo. Returns whether the history
+// moments, history length and the pixel's guide. Returns whether the history
 // contributed (for a reused right pixel: whether the left eye's had).
 // Each pass is written for S signals (1 or 2) known at compile time, so that the per-signal arrays
 // stay in registers on the GPU; the untemplated names choose S from the inputs.
@@ -305,7 +304,6 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
   Vec3 signal[2], albedo;
   DenoiseGuide guide;
   demodulatedInputs(v, pixel, signal, albedo, guide);
-  v.albedo[pixel] = albedo;
   v.guide[pixel] = guide;
   inverseDepthGradient(v.in.inverseDepth, v.camera, x, y, denoiseSpacing(v, pixel), v.depthGradient[2 * pixel],
                        v.depthGradient[2 * pixel + 1]);
@@ -416,7 +414,9 @@ PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v,
 // The denoised colour of a pixel the eye filters: its filtered signals remodulated.
 PVR_HOST_DEVICE inline void writeDenoised(const DenoiseFrameView& v, size_t pixel, Vec3 demodulated) {
   const Vec3 emitted = v.in.direct && v.in.emitted ? v.in.emitted[pixel] : Vec3(0.0f);
-  v.out[pixel] = emitted + demodulated * v.albedo[pixel];
+  // The albedo demodulated by, read again rather than kept: a pixel's buffer less to write.
+  const Vec3 albedo = v.in.albedo ? demodulationAlbedo(v.in.albedo[pixel]) : Vec3(1.0f);
+  v.out[pixel] = emitted + demodulated * albedo;
 }
 
 // Whether the pixel is refining this frame: the view is still and the pixel kept its history.
