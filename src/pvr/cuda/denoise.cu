@@ -137,12 +137,9 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   const int e = int(eye);
   EyeState& state = eyes_[e];
   const size_t pixels = size_t(camera.width) * camera.height;
-  const int signals = in.direct ? 2 : 1;
-  if (state.valid && (state.camera.width != camera.width || state.camera.height != camera.height || state.signals != signals))
-    state.valid = false;
-  History& previous = state.history[state.latest];
-  History& next = state.history[state.latest ^ 1];
-  const int levels = in.keepLevels ? params.iterations + 1 : 2;
+  const int signals = in.direct ? 2 : 1, levels = EyeState::levelBuffers(params, in);
+  state.begin(camera, in);
+  EyeState::History& next = state.next();
   for (int s = 0; s < signals; ++s) {
     next.colour[s].reserve(pixels, "denoiser history");
     for (int k = 0; k < levels; ++k) {
@@ -161,42 +158,8 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   state.out.reserve(pixels, "denoised image");
   state.filteredPixels.reserve(pixels, "denoiser pixel list");
   filteredCount_.reserve(2, "denoiser pixel count");
-
-  DenoiseFrameView v;
-  v.camera = camera;
-  v.in = in;
-  v.params = params;
-  v.stillFrames = stillFrames;
-  if (state.valid) {
-    v.history.camera = state.camera;
-    for (int s = 0; s < signals; ++s) v.history.colour[s] = previous.colour[s].data();
-    v.history.moments = previous.moments.data();
-    v.history.length = previous.length.data();
-    v.history.guide = previous.guide.data();
-  }
-  v.depthGradient = state.depthGradient.data();
-  v.guide = next.guide.data();
-  v.moments = next.moments.data();
-  v.length = next.length.data();
-  for (int s = 0; s < signals; ++s) {
-    for (int k = 0; k < kDenoiseLevels; ++k)
-      v.filtered[s][k] = state.levels[s][in.keepLevels ? std::min(k, levels - 1) : k & 1].data();
-    v.historyOut[s] = next.colour[s].data();
-  }
-  v.out = state.out.data();
-  if (in.reusedFrom) {
-    const EyeState& left = eyes_[int(Eye::Left)];
-    if (eye != Eye::Right || !left.valid || left.keptLevels < params.iterations + 1 || left.signals != signals ||
-        !in.sourceDenoised)
-      throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
-    const History& shared = left.history[left.latest];
-    for (int s = 0; s < signals; ++s) {
-      v.source.history[s] = shared.colour[s].data();
-      for (int k = 0; k <= params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
-    }
-    v.source.moments = shared.moments.data();
-    v.source.length = shared.length.data();
-  }
+  const DenoiseFrameView v =
+      denoiseFrameView(eye, camera, params, in, stillFrames, state, eyes_[int(Eye::Left)], state.out.data());
 
   const dim3 grid(unsigned((camera.width + kBlock - 1) / kBlock), unsigned((camera.height + kBlock - 1) / kBlock));
   const dim3 block(kBlock, kBlock);
@@ -231,18 +194,15 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
       else launch("denoise a-trous", atrousTileKernel<1>, blocks, block, 0, stream, v, i, levels, tilesX);
     }
   }
-  state.latest ^= 1;
-  state.camera = camera;
-  state.signals = signals;
-  state.keptLevels = in.keepLevels ? levels : 0;
-  state.valid = true;
+  state.end(camera, params, in);
 }
 
 size_t GpuDenoiser::memoryBytes() const {
   size_t bytes = filteredCount_.bytes();
   for (const EyeState& s : eyes_) {
-    bytes += s.history[0].bytes() + s.history[1].bytes() + s.depthGradient.bytes() + s.out.bytes() +
-             s.filteredPixels.bytes();
+    bytes += s.depthGradient.bytes() + s.out.bytes() + s.filteredPixels.bytes();
+    for (const EyeState::History& h : s.history)
+      bytes += h.colour[0].bytes() + h.colour[1].bytes() + h.moments.bytes() + h.length.bytes() + h.guide.bytes();
     for (int k = 0; k < 2; ++k)
       for (const auto& level : s.levels[k]) bytes += level.bytes();
   }

@@ -3,7 +3,7 @@
 // code (pvr/denoise/svgf.h). The accumulation runs over every pixel and lists those the eye
 // filters; the variance and a-trous passes run over that list only.
 #include "pvr/cuda/cuda_util.cuh"
-#include "pvr/denoise/svgf.h"
+#include "pvr/denoise/denoise_eye_state.h"
 
 namespace pvr::cuda {
 
@@ -19,22 +19,9 @@ class GpuDenoiser {
   size_t memoryBytes() const;
 
  private:
-  struct History {
-    DeviceBuffer<ColourVariance> colour[2];
-    DeviceBuffer<float> moments, length;
-    DeviceBuffer<DenoiseGuide> guide;
-    size_t bytes() const { return colour[0].bytes() + colour[1].bytes() + moments.bytes() + length.bytes() + guide.bytes(); }
-  };
-  struct EyeState {
-    History history[2];
-    int latest = 0, signals = 0;
-    int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)
-    bool valid = false;
-    EyeCamera camera;
+  struct EyeState : DenoiseEyeState<DeviceBuffer> {
     DeviceBuffer<Vec3> out;
-    DeviceBuffer<float> depthGradient;
-    DeviceBuffer<ColourVariance> levels[2][kDenoiseLevels];  ///< two (ping-pong) unless keepLevels
-    DeviceBuffer<uint32_t> filteredPixels;                   ///< the pixels the eye filters, in warps of neighbours
+    DeviceBuffer<uint32_t> filteredPixels;  ///< the pixels the eye filters, in 16x16-tile order
   };
   EyeState eyes_[2];
   DeviceBuffer<unsigned> filteredCount_;  ///< per eye, the length of filteredPixels

@@ -1,6 +1,5 @@
 #include "pvr/denoise/host_denoiser.h"
 
-#include <algorithm>
 #include <atomic>
 
 #include "pvr/util/error.h"
@@ -24,12 +23,9 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   if (!in.image || !in.inverseDepth) throw Error("the denoiser needs the eye's image and its per-pixel depth");
   EyeState& state = eyes_[int(eye)];
   const size_t pixels = size_t(camera.width) * camera.height;
-  const int signals = in.direct ? 2 : 1;
-  if (state.valid && (state.camera.width != camera.width || state.camera.height != camera.height || state.signals != signals))
-    state.valid = false;
-  const History& previous = state.history[state.latest];
-  History& next = state.history[state.latest ^ 1];
-  const int levels = in.keepLevels ? params.iterations + 1 : 2;
+  const int signals = in.direct ? 2 : 1, levels = EyeState::levelBuffers(params, in);
+  state.begin(camera, in);
+  EyeState::History& next = state.next();
   for (int s = 0; s < signals; ++s) {
     next.colour[s].resize(pixels);
     for (int k = 0; k < levels; ++k) state.levels[s][k].resize(pixels);
@@ -39,41 +35,8 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   next.guide.resize(pixels);
   state.depthGradient.resize(2 * pixels);
   out = Image(camera.width, camera.height);
-
-  DenoiseFrameView v;
-  v.camera = camera;
-  v.in = in;
-  v.params = params;
-  v.stillFrames = stillFrames;
-  if (state.valid) {
-    v.history.camera = state.camera;
-    for (int s = 0; s < signals; ++s) v.history.colour[s] = previous.colour[s].data();
-    v.history.moments = previous.moments.data();
-    v.history.length = previous.length.data();
-    v.history.guide = previous.guide.data();
-  }
-  v.depthGradient = state.depthGradient.data();
-  v.guide = next.guide.data();
-  v.moments = next.moments.data();
-  v.length = next.length.data();
-  for (int s = 0; s < signals; ++s) {
-    for (int k = 0; k < kDenoiseLevels; ++k) v.filtered[s][k] = state.levels[s][in.keepLevels ? std::min(k, levels - 1) : k & 1].data();
-    v.historyOut[s] = next.colour[s].data();
-  }
-  v.out = out.pixels.data();
-  if (in.reusedFrom) {
-    const EyeState& left = eyes_[int(Eye::Left)];
-    if (eye != Eye::Right || !left.valid || left.keptLevels < params.iterations + 1 || left.signals != signals ||
-        !in.sourceDenoised)
-      throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
-    const History& shared = left.history[left.latest];
-    for (int s = 0; s < signals; ++s) {
-      v.source.history[s] = shared.colour[s].data();
-      for (int k = 0; k <= params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
-    }
-    v.source.moments = shared.moments.data();
-    v.source.length = shared.length.data();
-  }
+  const DenoiseFrameView v =
+      denoiseFrameView(eye, camera, params, in, stillFrames, state, eyes_[int(Eye::Left)], out.pixels.data());
 
   std::atomic<size_t> used{0};
   forEachPixel("denoise accumulate", camera, [&](int x, int y) {
@@ -94,11 +57,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
       forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, levels, x, y); });
     }
   }
-  state.latest ^= 1;
-  state.camera = camera;
-  state.signals = signals;
-  state.keptLevels = in.keepLevels ? levels : 0;
-  state.valid = true;
+  state.end(camera, params, in);
   return used;
 }
 

@@ -3,7 +3,7 @@
 // svgf.h over its pixels, in parallel rows.
 #include <vector>
 
-#include "pvr/denoise/svgf.h"
+#include "pvr/denoise/denoise_eye_state.h"
 #include "pvr/image/image.h"
 
 namespace pvr {
@@ -18,21 +18,9 @@ class HostDenoiser {
   void forget(Eye eye) { eyes_[int(eye)].valid = false; }
 
  private:
-  // What one frame leaves for the next.
-  struct History {
-    std::vector<ColourVariance> colour[2];
-    std::vector<float> moments, length;
-    std::vector<DenoiseGuide> guide;
-  };
-  struct EyeState {
-    History history[2];  ///< ping-pong: the last frame's, and the one being written
-    int latest = 0, signals = 0;
-    bool valid = false;
-    EyeCamera camera;
-    std::vector<float> depthGradient;
-    std::vector<ColourVariance> levels[2][kDenoiseLevels];  ///< two (ping-pong) unless keepLevels
-    int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)
-  };
+  template <class T>
+  using HostBuffer = std::vector<T>;
+  using EyeState = DenoiseEyeState<HostBuffer>;
   EyeState eyes_[2];
 };
 

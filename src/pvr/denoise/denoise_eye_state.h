@@ -1,0 +1,94 @@
+#pragma once
+// One eye's denoising state over either backend's buffers (host vectors, device buffers: anything
+// with data()), and the frame's view of it: written once for the HostDenoiser and the GpuDenoiser,
+// which only size the buffers their own way and run the passes.
+#include <algorithm>
+
+#include "pvr/denoise/svgf.h"
+#include "pvr/util/error.h"
+
+namespace pvr {
+
+template <template <class> class Buffer>
+struct DenoiseEyeState {
+  // What one frame leaves for the next.
+  struct History {
+    Buffer<ColourVariance> colour[2];
+    Buffer<float> moments, length;
+    Buffer<DenoiseGuide> guide;
+  };
+  History history[2];  ///< ping-pong: the last frame's, and the one being written
+  int latest = 0, signals = 0;
+  int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)
+  bool valid = false;
+  EyeCamera camera;
+  Buffer<float> depthGradient;
+  Buffer<ColourVariance> levels[2][kDenoiseLevels];  ///< two (ping-pong) unless keepLevels
+
+  History& next() { return history[latest ^ 1]; }
+  // Level buffers this frame needs: each level its own for a left eye that a right eye reuses.
+  static int levelBuffers(const DenoiseParams& params, const DenoiseInputs& in) {
+    return in.keepLevels ? params.iterations + 1 : 2;
+  }
+  // Starts a frame: a history of another size or number of signals is not read.
+  void begin(const EyeCamera& c, const DenoiseInputs& in) {
+    if (valid && (camera.width != c.width || camera.height != c.height || signals != (in.direct ? 2 : 1))) valid = false;
+  }
+  // Ends the frame: its history becomes the one read next.
+  void end(const EyeCamera& c, const DenoiseParams& params, const DenoiseInputs& in) {
+    latest ^= 1;
+    camera = c;
+    signals = in.direct ? 2 : 1;
+    keptLevels = in.keepLevels ? levelBuffers(params, in) : 0;
+    valid = true;
+  }
+};
+
+// The frame's view of one eye's (sized) buffers: the history read (where valid) and written, the
+// filter's levels, and for a reusing right eye (in.reusedFrom) the left eye's new history and
+// levels of this frame; a left eye that kept none is refused.
+template <class State>
+DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const DenoiseParams& params, const DenoiseInputs& in,
+                                  int stillFrames, State& state, const State& left, Vec3* out) {
+  const int signals = in.direct ? 2 : 1, levels = State::levelBuffers(params, in);
+  DenoiseFrameView v;
+  v.camera = camera;
+  v.in = in;
+  v.params = params;
+  v.stillFrames = stillFrames;
+  if (state.valid) {
+    const auto& previous = state.history[state.latest];
+    v.history.camera = state.camera;
+    for (int s = 0; s < signals; ++s) v.history.colour[s] = previous.colour[s].data();
+    v.history.moments = previous.moments.data();
+    v.history.length = previous.length.data();
+    v.history.guide = previous.guide.data();
+  }
+  auto& next = state.next();
+  v.depthGradient = state.depthGradient.data();
+  v.guide = next.guide.data();
+  v.moments = next.moments.data();
+  v.length = next.length.data();
+  const int lastLevel = std::max(levels - 1, 0);  // the views past the frame's levels point at its last
+  for (int s = 0; s < signals; ++s) {
+    for (int k = 0; k < kDenoiseLevels; ++k)
+      v.filtered[s][k] = state.levels[s][in.keepLevels ? std::min(k, lastLevel) : k & 1].data();
+    v.historyOut[s] = next.colour[s].data();
+  }
+  v.out = out;
+  if (in.reusedFrom) {
+    if (eye != Eye::Right || !left.valid || left.keptLevels < params.iterations + 1 || left.signals != signals ||
+        !in.sourceDenoised)
+      throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
+    const auto& shared = left.history[left.latest];
+    for (int s = 0; s < signals; ++s) {
+      v.source.history[s] = shared.colour[s].data();
+      for (int k = 0; k <= params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
+    }
+    v.source.moments = shared.moments.data();
+    v.source.length = shared.length.data();
+  }
+  return v;
+}
+
+}  // namespace pvr
