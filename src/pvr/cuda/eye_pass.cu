@@ -1,6 +1,7 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_select.cuh>
 #include <thrust/iterator/counting_iterator.h>
+#include <type_traits>
 
 #include "pvr/cuda/density.cuh"
 #include "pvr/cuda/eye_kernels.cuh"
@@ -99,12 +100,21 @@ __global__ void __launch_bounds__(kTile* kTile) firstHitsKernel(SceneIntersector
   hits[size_t(y) * camera.width + x] = pixelFirstHit(intersector, params, camera, eye, x, y);
 }
 
+// A kernel template's instance for a stereo role, `pick(role constant)`: the role is a template
+// argument, so an eye that neither records nor reuses surfaces compiles those tests away.
+template <class Pick>
+auto byRole(StereoRole role, Pick pick) {
+  switch (role) {
+    case StereoRole::Reuser: return pick(std::integral_constant<StereoRole, StereoRole::Reuser>{});
+    case StereoRole::Source: return pick(std::integral_constant<StereoRole, StereoRole::Source>{});
+    default: return pick(std::integral_constant<StereoRole, StereoRole::Alone>{});
+  }
+}
+
 template <Estimator E, class Map>
 void launchSingle(const DeviceScene& scene, const Map& map, const GatherParams& params, const EyeCamera& camera,
                   Eye eye, StereoRole role, const StereoReuseView& reuse, const EyeOutputs& out, cudaStream_t stream) {
-  auto* kernel = role == StereoRole::Reuser   ? singleKernel<Map, E, StereoRole::Reuser>
-                 : role == StereoRole::Source ? singleKernel<Map, E, StereoRole::Source>
-                                              : singleKernel<Map, E, StereoRole::Alone>;
+  auto* kernel = byRole(role, [](auto r) { return singleKernel<Map, E, decltype(r)::value>; });
   launch("eye rays + density (single kernel)", kernel, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0,
          stream, scene.view, scene.intersector, map, params, camera, eye, reuse, out);
 }
@@ -231,20 +241,10 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
     shadowsBlocked_.reserve(kMaxDeferredShadows * pixels, "deferred shadow answers");
     shadows = DeferredShadowsView{shadowQueries_.data(), shadowsAsked_.data(), shadowsBlocked_.data(), pixels};
   }
-  using EyeRaysKernel = void (*)(SceneView, SceneIntersector, GatherParams, EyeCamera, Eye, int, StereoReuseView,
-                                 GatherPointStore, EyeOutputs, DeferredShadowsView);
-  EyeRaysKernel eyeRays = nullptr;
-  if (deferred)
-    eyeRays = pass.role == StereoRole::Reuser   ? eyeRaysKernel<StereoRole::Reuser, true>
-              : pass.role == StereoRole::Source ? eyeRaysKernel<StereoRole::Source, true>
-                                                : eyeRaysKernel<StereoRole::Alone, true>;
-  else
-    eyeRays = pass.role == StereoRole::Reuser   ? eyeRaysKernel<StereoRole::Reuser, false>
-              : pass.role == StereoRole::Source ? eyeRaysKernel<StereoRole::Source, false>
-                                                : eyeRaysKernel<StereoRole::Alone, false>;
-  auto* recordShadows = pass.role == StereoRole::Reuser   ? recordShadowsKernel<StereoRole::Reuser>
-                        : pass.role == StereoRole::Source ? recordShadowsKernel<StereoRole::Source>
-                                                          : recordShadowsKernel<StereoRole::Alone>;
+  auto* eyeRays = byRole(pass.role, [deferred](auto r) {
+    return deferred ? eyeRaysKernel<decltype(r)::value, true> : eyeRaysKernel<decltype(r)::value, false>;
+  });
+  auto* recordShadows = byRole(pass.role, [](auto r) { return recordShadowsKernel<decltype(r)::value>; });
   const int samples = params.samplesPerPixel;
   for (int s = 0; s < samples; ++s) {
     {

@@ -10,6 +10,7 @@ struct DenoiseParams {
   float sigmaLuminance = 4.0f;   ///< luminance edge-stopping, in local standard deviations
   float normalPower = 128.0f;    ///< normal edge-stopping: exp(-power (1 - cos))
   float depthTolerance = 0.02f;  ///< relative inverse-depth difference off the pixel's plane: another surface
+  bool bicubicHistory = true;    ///< a moving head's history read by Catmull-Rom where its 4x4 taps agree (else bilinear)
   // Progressive refinement while the head is still (within the tolerances below from the last
   // frame): the frames' signals are averaged with 1 / n (not the moving head's alpha floor), new
   // photons each frame with a radius shrinking by Knaus-Zwicker's rule (refineAlpha, down to

@@ -91,7 +91,7 @@ struct DenoiseSharedView {
 struct DenoiseHistoryView {
   EyeCamera camera;
   const ColourVariance* colour[2] = {nullptr, nullptr};  ///< direct, photon map
-  const float* moments = nullptr;                        ///< 4 per pixel: mean, mean square of each signal's luminance
+  const float* moments = nullptr;                        ///< 4 per pixel: each signal's luminance mean and variance
   const float* length = nullptr;                         ///< frames accumulated
   const DenoiseGuide* guide = nullptr;
   PVR_HOST_DEVICE bool valid() const { return guide != nullptr; }
@@ -267,6 +267,42 @@ PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t 
   guide.inverseDepth = in.inverseDepth[pixel];
 }
 
+// Whether history pixel (hx, hy) saw the surface a pixel with `guide` reprojects onto (inverse
+// depth `expected` there).
+PVR_HOST_DEVICE inline bool sameHistorySurface(const DenoiseHistoryView& h, int hx, int hy, float expected,
+                                               const DenoiseGuide& guide, const DenoiseParams& params) {
+  if (hx < 0 || hy < 0 || hx >= h.camera.width || hy >= h.camera.height) return false;
+  const DenoiseGuide& g = h.guide[denoisePixel(h.camera, hx, hy)];
+  if ((g.inverseDepth > 0.0f) != (expected > 0.0f)) return false;
+  if (expected > 0.0f && !(fabsf(g.inverseDepth - expected) <= params.depthTolerance * fmaxf(g.inverseDepth, expected)))
+    return false;
+  if (isBlack(g.normal) != isBlack(guide.normal)) return false;
+  return isBlack(guide.normal) || dot(g.normal, guide.normal) >= kDenoiseMinNormalCosine;
+}
+
+// The history's colours and luminance means at fraction (tx, ty) past pixel (x0, y0) by
+// Catmull-Rom over the 4x4 pixels around; false (and the outputs unfinished) where one of them saw
+// another surface.
+template <int S>
+PVR_HOST_DEVICE inline bool catmullRomHistory(const DenoiseHistoryView& h, int x0, int y0, float tx, float ty,
+                                              float expected, const DenoiseGuide& guide, const DenoiseParams& params,
+                                              Vec3 colour[2], float mean[2]) {
+  float wx[4], wy[4];
+  catmullRomWeights(tx, wx);
+  catmullRomWeights(ty, wy);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const int hx = x0 - 1 + i, hy = y0 - 1 + j;
+      if (!sameHistorySurface(h, hx, hy, expected, guide, params)) return false;
+      const size_t at = denoisePixel(h.camera, hx, hy);
+      for (int s = 0; s < S; ++s) {
+        colour[s] += h.colour[s][at].colour * (wx[i] * wy[j]);
+        mean[s] += h.moments[4 * at + 2 * s] * (wx[i] * wy[j]);
+      }
+    }
+  return true;
+}
+
 // Step 2 for a pixel the eye does not filter. A reused right pixel takes the left eye's new
 // history at the pixel it reused (so it carries that history on if it is shaded by its own eye
 // next frame) and shows the left eye's denoised colour there: one denoise of that surface, and
@@ -307,11 +343,12 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
   v.guide[pixel] = guide;
   inverseDepthGradient(v.in.inverseDepth, v.camera, x, y, denoiseSpacing(v, pixel), v.depthGradient[2 * pixel],
                        v.depthGradient[2 * pixel + 1]);
-  float moments[4];
-  for (int s = 0; s < 2; ++s) {
-    const float l = luminance(signal[s]);
-    moments[2 * s] = l, moments[2 * s + 1] = l * l;
-  }
+  // Each signal's luminance: its mean and variance over the accumulated frames (kept as mean and
+  // variance, not mean and mean square: a moving head resamples them, and averaging neighbours'
+  // mean squares would count the spread of their means, a sharp edge or gradient of the signal,
+  // as noise, so the filter would blur it by an amount that changes with the sub-pixel offset).
+  float luminances[2];
+  for (int s = 0; s < 2; ++s) luminances[s] = luminance(signal[s]);
 
   // The history's 2x2 taps around where the pixel was, those that saw this surface.
   Vec3 history[2] = {Vec3(0.0f), Vec3(0.0f)};
@@ -329,23 +366,41 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
       if (fabsf(fx - sx) < kTaaSnapPixels && fabsf(fy - sy) < kTaaSnapPixels) fx = sx, fy = sy;  // a still head
       const int x0 = int(floorf(fx)), y0 = int(floorf(fy));
       const float tx = fx - float(x0), ty = fy - float(y0);
+      Vec3 lowest[2], highest[2];  // the taps' range per signal: the bicubic read's clamp
+      float lowestMean[2] = {0, 0}, highestMean[2] = {0, 0};
       for (int j = 0; j < 2; ++j)
         for (int i = 0; i < 2; ++i) {
           const int hx = x0 + i, hy = y0 + j;
           const float w = (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
-          if (!(w > 0.0f) || hx < 0 || hy < 0 || hx >= h.camera.width || hy >= h.camera.height) continue;
+          if (!(w > 0.0f) || !sameHistorySurface(h, hx, hy, expected, guide, v.params)) continue;
           const size_t at = denoisePixel(h.camera, hx, hy);
-          const DenoiseGuide& g = h.guide[at];
-          if ((g.inverseDepth > 0.0f) != (expected > 0.0f)) continue;
-          if (expected > 0.0f && !(fabsf(g.inverseDepth - expected) <= v.params.depthTolerance * fmaxf(g.inverseDepth, expected)))
-            continue;
-          if (isBlack(g.normal) != isBlack(guide.normal)) continue;
-          if (!isBlack(guide.normal) && !(dot(g.normal, guide.normal) >= kDenoiseMinNormalCosine)) continue;
-          for (int s = 0; s < S; ++s) history[s] += h.colour[s][at].colour * w;
+          for (int s = 0; s < S; ++s) {
+            const Vec3 c = h.colour[s][at].colour;
+            history[s] += c * w;
+            const float m = h.moments[4 * at + 2 * s];
+            lowest[s] = total > 0.0f ? min(lowest[s], c) : c;
+            highest[s] = total > 0.0f ? max(highest[s], c) : c;
+            lowestMean[s] = total > 0.0f ? fminf(lowestMean[s], m) : m;
+            highestMean[s] = total > 0.0f ? fmaxf(highestMean[s], m) : m;
+          }
           for (int m = 0; m < 4; ++m) historyMoments[m] += h.moments[4 * at + m] * w;
           historyLength += h.length[at] * w;
           total += w;
         }
+      // A moving head resamples the history every frame: bilinear weights blur it by an amount
+      // that changes with the sub-pixel offset, frame to frame (a flicker of its own). Where all
+      // 4x4 taps around the point saw this surface, the colour and the luminance mean are read by
+      // Catmull-Rom instead (sharp, exact at pixel centres), within the 2x2 taps' range (no
+      // ringing). Variances and the history's length stay bilinear (smooth, and never negative).
+      if (v.params.bicubicHistory && total > 0.999f && (tx > 0.0f || ty > 0.0f)) {
+        Vec3 bicubic[2] = {Vec3(0.0f), Vec3(0.0f)};
+        float bicubicMean[2] = {0.0f, 0.0f};
+        if (catmullRomHistory<S>(h, x0, y0, tx, ty, expected, guide, v.params, bicubic, bicubicMean))
+          for (int s = 0; s < S; ++s) {
+            history[s] = min(max(bicubic[s], lowest[s]), highest[s]) * total;
+            historyMoments[2 * s] = fminf(fmaxf(bicubicMean[s], lowestMean[s]), highestMean[s]) * total;
+          }
+      }
     }
   }
   // The frames the accumulated average stands for: one more than the history's. A moving head
@@ -361,17 +416,24 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
   else if (frames > moving) frames = fmaxf(moving, 0.5f * frames);
   const float alpha = 1.0f / frames;
   const float alphaMoments = refining ? alpha : fmaxf(v.params.momentsAlpha, alpha);
-  for (int m = 0; m < 4; ++m) {
-    const float previous = used ? historyMoments[m] / total : 0.0f;
-    moments[m] = previous + (moments[m] - previous) * alphaMoments;
-    v.moments[4 * pixel + m] = moments[m];
+  float variances[2];
+  for (int s = 0; s < 2; ++s) {
+    float mean = luminances[s], variance = 0.0f;
+    if (used) {
+      // An exponentially weighted mean and variance (a running one while refining).
+      const float previousMean = historyMoments[2 * s] / total, difference = luminances[s] - previousMean;
+      mean = previousMean + difference * alphaMoments;
+      variance = (1.0f - alphaMoments) * (historyMoments[2 * s + 1] / total + alphaMoments * difference * difference);
+    }
+    v.moments[4 * pixel + 2 * s] = mean, v.moments[4 * pixel + 2 * s + 1] = variance;
+    variances[s] = variance;
   }
   v.length[pixel] = frames;
   for (int s = 0; s < S; ++s) {
     const Vec3 previous = used ? history[s] / total : Vec3(0.0f);
     ColourVariance c;
     c.colour = previous + (signal[s] - previous) * alpha;
-    c.variance = fmaxf(0.0f, moments[2 * s + 1] - moments[2 * s] * moments[2 * s]);
+    c.variance = variances[s];
     // Beyond the moving head's frames the filter sees the average's variance, so it fades out as
     // that falls; a refining history is the plain average, never a filtered one.
     c.variance *= fminf(1.0f, alpha * moving);
@@ -393,8 +455,17 @@ PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v,
   const DenoiseGuide p = v.guide[pixel];
   const int step = denoiseSpacing(v, pixel);
   const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
+  // The window's luminance mean and mean square (each pixel's variance plus its squared mean).
   float sum[4], total = 1.0f;
-  for (int m = 0; m < 4; ++m) sum[m] = v.moments[4 * pixel + m];
+  auto add = [&](size_t q, float w) {
+    for (int s = 0; s < 2; ++s) {
+      const float mean = v.moments[4 * q + 2 * s];
+      sum[2 * s] += mean * w;
+      sum[2 * s + 1] += (v.moments[4 * q + 2 * s + 1] + mean * mean) * w;
+    }
+  };
+  for (int m = 0; m < 4; ++m) sum[m] = 0.0f;
+  add(pixel, 1.0f);
   for (int j = -3; j <= 3; j += 2)
     for (int i = -3; i <= 3; i += 2) {
       const int qx = x + i * step, qy = y + j * step;
@@ -402,7 +473,7 @@ PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v,
       const size_t q = denoisePixel(v.camera, qx, qy);
       const float w = geometryWeight(p, v.guide[q], gx, gy, float(i * step), float(j * step), v.params);
       if (!(w > 0.0f)) continue;
-      for (int m = 0; m < 4; ++m) sum[m] += v.moments[4 * q + m] * w;
+      add(q, w);
       total += w;
     }
   for (int s = 0; s < S; ++s) {
