@@ -281,8 +281,8 @@ PVR_HOST_DEVICE inline bool sameHistorySurface(const DenoiseHistoryView& h, int 
 }
 
 // The history's colours and luminance means at fraction (tx, ty) past pixel (x0, y0) by
-// Catmull-Rom over the 4x4 pixels around; false (and the outputs unfinished) where one of them saw
-// another surface.
+// Catmull-Rom over the 4x4 pixels around, each clamped to the range of the 2x2 pixels nearest (no
+// ringing); false (and the outputs unfinished) where one of the 4x4 saw another surface.
 template <int S>
 PVR_HOST_DEVICE inline bool catmullRomHistory(const DenoiseHistoryView& h, int x0, int y0, float tx, float ty,
                                               float expected, const DenoiseGuide& guide, const DenoiseParams& params,
@@ -300,6 +300,22 @@ PVR_HOST_DEVICE inline bool catmullRomHistory(const DenoiseHistoryView& h, int x
         mean[s] += h.moments[4 * at + 2 * s] * (wx[i] * wy[j]);
       }
     }
+  // The clamp, a signal at a time over the 2x2 nearest (read again: cached, and fewer registers
+  // held through the taps above on the GPU).
+  for (int s = 0; s < S; ++s) {
+    const size_t at = denoisePixel(h.camera, x0, y0);
+    Vec3 lowest = h.colour[s][at].colour, highest = lowest;
+    float lowestMean = h.moments[4 * at + 2 * s], highestMean = lowestMean;
+    for (int k = 1; k < 4; ++k) {
+      const size_t q = at + size_t(k & 1) + size_t(k >> 1) * size_t(h.camera.width);
+      const Vec3 c = h.colour[s][q].colour;
+      const float m = h.moments[4 * q + 2 * s];
+      lowest = min(lowest, c), highest = max(highest, c);
+      lowestMean = fminf(lowestMean, m), highestMean = fmaxf(highestMean, m);
+    }
+    colour[s] = min(max(colour[s], lowest), highest);
+    mean[s] = fminf(fmaxf(mean[s], lowestMean), highestMean);
+  }
   return true;
 }
 
@@ -366,23 +382,13 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
       if (fabsf(fx - sx) < kTaaSnapPixels && fabsf(fy - sy) < kTaaSnapPixels) fx = sx, fy = sy;  // a still head
       const int x0 = int(floorf(fx)), y0 = int(floorf(fy));
       const float tx = fx - float(x0), ty = fy - float(y0);
-      Vec3 lowest[2], highest[2];  // the taps' range per signal: the bicubic read's clamp
-      float lowestMean[2] = {0, 0}, highestMean[2] = {0, 0};
       for (int j = 0; j < 2; ++j)
         for (int i = 0; i < 2; ++i) {
           const int hx = x0 + i, hy = y0 + j;
           const float w = (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
           if (!(w > 0.0f) || !sameHistorySurface(h, hx, hy, expected, guide, v.params)) continue;
           const size_t at = denoisePixel(h.camera, hx, hy);
-          for (int s = 0; s < S; ++s) {
-            const Vec3 c = h.colour[s][at].colour;
-            history[s] += c * w;
-            const float m = h.moments[4 * at + 2 * s];
-            lowest[s] = total > 0.0f ? min(lowest[s], c) : c;
-            highest[s] = total > 0.0f ? max(highest[s], c) : c;
-            lowestMean[s] = total > 0.0f ? fminf(lowestMean[s], m) : m;
-            highestMean[s] = total > 0.0f ? fmaxf(highestMean[s], m) : m;
-          }
+          for (int s = 0; s < S; ++s) history[s] += h.colour[s][at].colour * w;
           for (int m = 0; m < 4; ++m) historyMoments[m] += h.moments[4 * at + m] * w;
           historyLength += h.length[at] * w;
           total += w;
@@ -390,16 +396,13 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
       // A moving head resamples the history every frame: bilinear weights blur it by an amount
       // that changes with the sub-pixel offset, frame to frame (a flicker of its own). Where all
       // 4x4 taps around the point saw this surface, the colour and the luminance mean are read by
-      // Catmull-Rom instead (sharp, exact at pixel centres), within the 2x2 taps' range (no
-      // ringing). Variances and the history's length stay bilinear (smooth, and never negative).
+      // Catmull-Rom instead (sharp, exact at pixel centres). Variances and the history's length
+      // stay bilinear (smooth, and never negative).
       if (v.params.bicubicHistory && total > 0.999f && (tx > 0.0f || ty > 0.0f)) {
         Vec3 bicubic[2] = {Vec3(0.0f), Vec3(0.0f)};
         float bicubicMean[2] = {0.0f, 0.0f};
         if (catmullRomHistory<S>(h, x0, y0, tx, ty, expected, guide, v.params, bicubic, bicubicMean))
-          for (int s = 0; s < S; ++s) {
-            history[s] = min(max(bicubic[s], lowest[s]), highest[s]) * total;
-            historyMoments[2 * s] = fminf(fmaxf(bicubicMean[s], lowestMean[s]), highestMean[s]) * total;
-          }
+          for (int s = 0; s < S; ++s) history[s] = bicubic[s] * total, historyMoments[2 * s] = bicubicMean[s] * total;
       }
     }
   }
