@@ -69,13 +69,18 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"denoise, gather reuse", true, false, 1, true, PixelSampling::BlueNoise, Boundary::Sphere,
                                   StereoMode::Gather}};
 
-// Whether the run asked for variant v (--quality-variants; the first, "raw", is every ratio's base
-// and always runs).
-bool selected(const FrameBenchArgs& args, const Variant& v) {
-  if (args.qualityVariants.empty() || &v == &kVariants[0]) return true;
-  for (const std::string& name : splitList(args.qualityVariants, ';'))
-    if (name == v.name) return true;
-  return false;
+// The variants the run asked for (--quality-variants; all where empty), each checked: the first,
+// "raw", is every ratio's base and always runs.
+std::vector<const Variant*> selectedVariants(const std::string& names) {
+  const std::vector<std::string> asked = names.empty() ? std::vector<std::string>() : splitList(names, ';');
+  for (const std::string& name : asked)
+    if (std::none_of(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; }))
+      throw Error("--quality-variants: no variant '" + name + "' in the quality suite");
+  std::vector<const Variant*> out;
+  for (const Variant& v : kVariants)
+    if (asked.empty() || &v == &kVariants[0] || std::find(asked.begin(), asked.end(), v.name) != asked.end())
+      out.push_back(&v);
+  return out;
 }
 
 // Flicker of shown frames a -> b where the reference does not change: the mean absolute change of
@@ -136,10 +141,7 @@ bool isSampled(int frame) {
 
 int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& json) {
   int failures = 0;
-  if (!args.qualityVariants.empty())
-    for (const std::string& name : splitList(args.qualityVariants, ';'))
-      if (std::none_of(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; }))
-        throw Error("--quality-variants: no variant '" + name + "' in the quality suite");
+  const std::vector<const Variant*> variants = selectedVariants(args.qualityVariants);
   if (args.referencePasses < 2 || args.referencePasses > kMaxReferencePasses / 4)
     throw Error("--reference-passes must be between 2 and " + std::to_string(kMaxReferencePasses / 4));
   std::printf("\nImage quality at the real-time settings (512x512 photons, 1 sample per pixel, full shading, hash grid, "
@@ -237,8 +239,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                 "flicker the reference does not explain | of raw | denoise ms / stereo frame (mean / p99) | "
                 "frame ms (mean / p99) | check |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     double rawRelMse = 0, rawFlicker = 0, rawUnexplained = 0;
-    for (const Variant& v : kVariants) {
-      if (!selected(args, v)) continue;
+    for (const Variant* variant : variants) {
+      const Variant& v = *variant;
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
       RenderOptions vo = o;
       vo.denoise.enabled = v.denoise;
@@ -315,8 +317,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
     std::printf("\n| scene | still head | relMSE frame 1 | after 1 s (90) | of frame 1 | after 5 s (450) | PSNR after 5 s | "
                 "SSIM after 5 s | then moving: largest change in 10 frames / moving median | check |\n"
                 "|---|---|---|---|---|---|---|---|---|---|\n");
-    for (const Variant& v : kVariants) {
-      if (!selected(args, v)) continue;
+    for (const Variant* variant : variants) {
+      const Variant& v = *variant;
       if (v.taa && !v.denoise) continue;  // TAA alone is the moving head's business
       // A still head retraces every photon each frame anyway, and refines with new numbers.
       if (v.photonBatches > 1 || !v.freshNoise) continue;
