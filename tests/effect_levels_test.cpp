@@ -136,6 +136,32 @@ TEST(EffectLevels, ReflectionsFollowsMirrorsAndGlassAsGiDoes) {
   EXPECT_GT(differsFromShadows, specular / 2) << "below reflections, mirrors and glass are shaded by their tint instead";
 }
 
+// The denoiser divides a pixel by the reflectance of the surface its path ends on, so that it
+// filters light, not texture. Every level ends its paths where gi does (on the Cornell box's
+// diffuse walls and blocks, and through its mirror and glass from reflections up), and must give
+// the same reflectance there, although below gi the point carries no estimate.
+TEST(EffectLevels, EveryLevelDemodulatesByTheSurfacesReflectance) {
+  for (const char* name : {"cornell", "cornell-caustics"}) {
+    const LevelPoints lp = levelPoints(name);
+    const auto& gi = lp.points[int(EffectLevel::Gi)];
+    size_t surfaces = 0;
+    for (size_t i = 0; i < gi.size(); ++i) {
+      if (gi[i].needsEstimate()) ++surfaces;
+      for (EffectLevel level : {EffectLevel::Raster, EffectLevel::Shadows, EffectLevel::Reflections, EffectLevel::Path}) {
+        if (lp.specularFirst[i] && level < EffectLevel::Reflections) continue;  // shaded by the tint, where gi follows
+        const Vec3 expected = gi[i].demodulationAlbedo(), got = lp.points[int(level)][i].demodulationAlbedo();
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(got[c], expected[c], 1e-6f) << name << " pixel " << i << " at " << effectLevelName(level);
+      }
+      if (!gi[i].needsEstimate()) continue;
+      // At gi: the path's throughput times the albedo, the weight times pi on these Lambertian walls.
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(gi[i].demodulationAlbedo()[c], gi[i].weight[c] * kPi, 1e-6f);
+      EXPECT_GT(luminance(gi[i].demodulationAlbedo()), 0.0f);
+    }
+    EXPECT_GT(surfaces, gi.size() / 4) << name;
+  }
+}
+
 // A rough glass panel (a microfacet surface that mostly transmits): below reflections nothing is
 // followed, so every eye path ends on the panel with its light estimated there (none goes black
 // on a follow decision that has no lobe to follow).

@@ -94,19 +94,17 @@ struct GatherPoint {
   Vec3 wo{0, 0, 0};      ///< towards where the path came from (lobes != 0)
   BsdfParams bsdf;       ///< (lobes != 0)
   Vec3 wall{0, 0, 0};    ///< Boundary::Clipped: the nearest wall, whose photons the estimate leaves out (photonCounts)
-  float discShare = 1;   ///< Boundary::Clipped: weight holds 1 / this, the disc's share on the surface (not stored on the GPU)
+  // What the denoiser divides the pixel by, so that it filters irradiance rather than texture:
+  // the path's reflectance towards the eye (throughput times albedo; the base colour on a
+  // microfacet surface), at every effect level (below Gi weight is zero, but the texture is
+  // there all the same). Zero where the path found no surface.
+  Vec3 reflectance{0, 0, 0};
   PVR_HOST_DEVICE bool needsEstimate() const { return !isBlack(weight); }
   // What a photon that reached the surface adds to the estimate before `weight` and 1 / (pi r^2).
   PVR_HOST_DEVICE Vec3 photonContribution(const Photon& p) const {
     return lobes == 0 ? p.power : bsdf.eval(wo, -p.direction, lobes) * p.power;
   }
-  // What the denoiser divides the pixel by, so that it filters irradiance rather than texture: the
-  // path's reflectance towards the eye (throughput times albedo; the base colour on a microfacet
-  // surface). Zero where the path found no surface to gather on.
-  // Boundary::Clipped's area factor is not reflectance: it is taken out again.
-  PVR_HOST_DEVICE Vec3 demodulationAlbedo() const {
-    return (lobes == 0 ? weight * kPi : weight * bsdf.baseColor) * discShare;
-  }
+  PVR_HOST_DEVICE Vec3 demodulationAlbedo() const { return reflectance; }
 };
 
 // What the denoiser needs of a pixel besides its radiance: its emitted part (lights and sky seen,
@@ -336,7 +334,6 @@ PVR_HOST_DEVICE void clipAtBoundaries(const SceneView& scene, const Intersector&
   point.wall = probe.wall;
   if (params.density.estimator != Estimator::Radius) return;
   point.weight *= 1.0f / probe.discShare;
-  point.discShare = probe.discShare;
 }
 
 // Follows the eye ray through mirrors and glass to a surface that gathers from the photon map.
@@ -399,8 +396,12 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
         out.radiance += throughput * diffuseDirectLight(scene, NoOccluders(), params, sp.position, nGeo, nShade, eps, lambertian, rng);
       else if (direct)
         out.radiance += throughput * diffuseDirectLight(scene, intersector, params, sp.position, nGeo, nShade, eps, lambertian, rng);
-      if (level == EffectLevel::Gi)
-        out.weight = throughput * brdf * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
+      out.reflectance = throughput * albedo;
+      if (level == EffectLevel::Gi) {
+        const float occlusion = scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, dot(ray.dir, nGeo));
+        out.weight = throughput * brdf * occlusion;
+        out.reflectance *= occlusion;
+      }
       if (level == EffectLevel::Path) {
         // Two statements: the order of evaluation of arguments differs between g++ and nvcc.
         float u1 = rng.uniform();
@@ -457,7 +458,12 @@ PVR_HOST_DEVICE GatherPoint traceToGatherPoint(const SceneView& scene, const Int
             out.radiance += scale * bs.weight * pathTracedRadiance(scene, intersector, params, Ray{sp.position + side * eps, bs.wi}, rng);
           }
         }
-        if (level == EffectLevel::Gi) out.weight = scale * scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
+        out.reflectance = scale * b.baseColor;
+        if (level == EffectLevel::Gi) {
+          const float occlusion = scene.occlusionAt(m, hit.primId, hit.u, hit.v, coneWidth, -dot(wo, nGeo));
+          out.weight = scale * occlusion;
+          out.reflectance *= occlusion;
+        }
         out.position = sp.position;
         out.normal = nGeo;
         out.lobes = gathered;
