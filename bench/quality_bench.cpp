@@ -46,6 +46,7 @@ struct Variant {
   PixelSampling sampling = PixelSampling::BlueNoise;
   Boundary boundary = Boundary::Sphere;  ///< the estimate where surfaces meet walls or end (photon/boundary.h)
   StereoMode stereo = StereoMode::Separate;
+  bool bicubicHistory = DenoiseParams().bicubicHistory;  ///< the denoiser's history read (--denoise-history)
 };
 constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"TAA", false, true, 1},
@@ -67,7 +68,10 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"raw, gather reuse", false, false, 1, true, PixelSampling::BlueNoise, Boundary::Sphere,
                                   StereoMode::Gather},
                                  {"denoise, gather reuse", true, false, 1, true, PixelSampling::BlueNoise, Boundary::Sphere,
-                                  StereoMode::Gather}};
+                                  StereoMode::Gather},
+                                 // The history read bilinearly (cheaper) against the default's Catmull-Rom.
+                                 {"denoise, bilinear history", true, false, 1, true, PixelSampling::BlueNoise,
+                                  Boundary::Sphere, StereoMode::Separate, false}};
 
 // The variants the run asked for (--quality-variants; all where empty), each checked: the first,
 // "raw", is every ratio's base and always runs.
@@ -305,7 +309,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"fresh_noise", v.freshNoise},
                       {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"},
                       {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"},
-                      {"stereo", stereoModeName(v.stereo)}, {"denoise_ms", dn},
+                      {"stereo", stereoModeName(v.stereo)}, {"history", v.bicubicHistory ? "catmull-rom" : "bilinear"},
+                      {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});
     }
@@ -322,9 +327,12 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       if (v.taa && !v.denoise) continue;  // TAA alone is the moving head's business
       // A still head retraces every photon each frame anyway, and refines with new numbers.
       if (v.photonBatches > 1 || !v.freshNoise) continue;
+      // A still head reads its history at pixel centres, where both reads agree.
+      if (v.bicubicHistory != DenoiseParams().bicubicHistory) continue;
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
       RenderOptions vo = o;
       vo.denoise.enabled = v.denoise;
+      vo.denoise.params.bicubicHistory = v.bicubicHistory;
       vo.temporal.enabled = v.taa;
       vo.stereo = v.stereo;
       vo.gather.sampling = v.sampling;

@@ -71,6 +71,8 @@ expect_error "--taa-blend" render cornell --taa --taa-blend nan --eye-size 8x8
 expect_error "--taa-blend" render cornell --taa --taa-blend 0.5x --eye-size 8x8
 expect_error "--denoise-iterations is for --denoise" render cornell --denoise-iterations 3 --eye-size 8x8
 expect_error "--no-refine is for --denoise" render cornell --no-refine --eye-size 8x8
+expect_error "--denoise-history is for --denoise" render cornell --denoise-history bilinear --eye-size 8x8
+expect_error "--denoise-history must be catmull-rom or bilinear, got 'cubic'" render cornell --denoise --denoise-history cubic --eye-size 8x8
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations 9 --eye-size 8x8
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations -1 --eye-size 8x8
 expect_error "--denoise-iterations" render cornell --denoise --denoise-iterations two --eye-size 8x8

@@ -102,6 +102,7 @@ struct RenderArgs {
   bool denoise = false;
   int denoiseIterations = DenoiseParams().iterations;
   bool noRefine = false;
+  std::string denoiseHistory;  // empty: DenoiseParams' default
   int photonBatches = 1;     // a rolling photon map's slices, one retraced per frame
   std::string out = "out/render";
   float exposure = 1.0f;
@@ -163,6 +164,7 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     flag("foveated", "--foveated", a.foveated);
     flag("taa", "--taa", a.taa);
     flag("denoise", "--denoise", a.denoise);
+    text("denoise_history", "--denoise-history", a.denoiseHistory);
     if (j.contains("denoise_iterations") && !given("--denoise-iterations"))
       a.denoiseIterations = j["denoise_iterations"].get<int>();
     if (j.contains("k") && !given("--k")) a.k = j["k"].get<int>();
@@ -256,6 +258,10 @@ void addDenoiseOptions(CLI::App& cmd, RenderArgs& a) {
                  "all but one (1/N of the photon tracing a frame; on the H200 it did not lower the flicker and "
                  "raised the error, docs/denoising.md; 1..64, 1: all photons every frame)")
       ->capture_default_str();
+  cmd.add_option("--denoise-history", a.denoiseHistory,
+                 "How --denoise reads the last frame's history under a moving head: catmull-rom (sharp; 4x4 taps "
+                 "where they all saw the surface, else bilinear) | bilinear (2x2 taps, cheaper)")
+      ->default_str(DenoiseParams().bicubicHistory ? "catmull-rom" : "bilinear");
   cmd.add_flag("--no-refine", a.noRefine,
                "With --denoise: no progressive refinement while the head is still (averaging still frames with a "
                "shrinking photon radius)");
@@ -388,6 +394,12 @@ RenderOptions optionsFromArgs(const RenderArgs& a, StereoRig& rig) {
   if (a.denoiseIterations != DenoiseParams().iterations && !a.denoise)
     throw Error("--denoise-iterations is for --denoise");
   if (a.noRefine && !a.denoise) throw Error("--no-refine is for --denoise");
+  if (!a.denoiseHistory.empty()) {
+    if (!a.denoise) throw Error("--denoise-history is for --denoise");
+    if (a.denoiseHistory != "catmull-rom" && a.denoiseHistory != "bilinear")
+      throw Error("--denoise-history must be catmull-rom or bilinear, got '" + a.denoiseHistory + "'");
+    options.denoise.params.bicubicHistory = a.denoiseHistory == "catmull-rom";
+  }
   options.denoise.params.refineWhenStill = !a.noRefine;
   options.denoise.enabled = a.denoise;
   options.denoise.params.iterations = a.denoiseIterations;
