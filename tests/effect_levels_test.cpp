@@ -149,14 +149,14 @@ TEST(EffectLevels, EveryLevelDemodulatesByTheSurfacesReflectance) {
       if (gi[i].needsEstimate()) ++surfaces;
       for (EffectLevel level : {EffectLevel::Raster, EffectLevel::Shadows, EffectLevel::Reflections, EffectLevel::Path}) {
         if (lp.specularFirst[i] && level < EffectLevel::Reflections) continue;  // shaded by the tint, where gi follows
-        const Vec3 expected = gi[i].demodulationAlbedo(), got = lp.points[int(level)][i].demodulationAlbedo();
+        const Vec3 expected = gi[i].reflectance, got = lp.points[int(level)][i].reflectance;
         for (int c = 0; c < 3; ++c)
           EXPECT_NEAR(got[c], expected[c], 1e-6f) << name << " pixel " << i << " at " << effectLevelName(level);
       }
       if (!gi[i].needsEstimate()) continue;
       // At gi: the path's throughput times the albedo, the weight times pi on these Lambertian walls.
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(gi[i].demodulationAlbedo()[c], gi[i].weight[c] * kPi, 1e-6f);
-      EXPECT_GT(luminance(gi[i].demodulationAlbedo()), 0.0f);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(gi[i].reflectance[c], gi[i].weight[c] * kPi, 1e-6f);
+      EXPECT_GT(luminance(gi[i].reflectance), 0.0f);
     }
     EXPECT_GT(surfaces, gi.size() / 4) << name;
   }

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <utility>
 
 #include "gpu_ray_throughput.h"
 #include "pvr/accel/wide_bvh_traversal.h"
@@ -243,12 +244,17 @@ TEST(GpuBackend, StereoReuseMatchesTheCpu) {
         o.gather.samplesPerPixel = spp;
         o.stereo = stereo;
         FrameResult reference = both.cpu.render(both.rig, o);
-        for (DensityKernel kernel : {DensityKernel::Single, DensityKernel::Hybrid, DensityKernel::SharedMemory,
-                                     DensityKernel::CellSorted}) {
+        // First hits apart: gather's right eye shades a list of the pixels it does not reuse.
+        for (auto [kernel, schedule] : {std::pair{DensityKernel::Single, RaySchedule::Auto},
+                                        {DensityKernel::Hybrid, RaySchedule::Auto},
+                                        {DensityKernel::Hybrid, RaySchedule::FirstHits},
+                                        {DensityKernel::SharedMemory, RaySchedule::Auto},
+                                        {DensityKernel::CellSorted, RaySchedule::FirstHits}}) {
           o.kernel = kernel;
+          o.raySchedule = schedule;
           FrameResult frame = both.gpu.render(both.rig, o);
           std::string what = std::string(name) + " " + stereoModeName(stereo) + " " + densityKernelName(kernel) +
-                             " spp " + std::to_string(spp);
+                             " " + rayScheduleName(schedule) + " spp " + std::to_string(spp);
           ImageCheck c = compare(reference, frame);
           EXPECT_LT(c.relativeMad, 0.01) << what;
           EXPECT_LT(c.outliers, 0.005) << what;

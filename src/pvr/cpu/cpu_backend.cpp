@@ -76,7 +76,7 @@ void CpuBackend::renderEyeCachedWith(const EyeCamera& camera, Eye eye, const Gat
           if (!guides) continue;
           const GatherPoint& p = points[pixel];
           PixelGuide& g = guides[pixel];
-          if (s == 0) g = PixelGuide(), g.albedo = p.demodulationAlbedo(), g.normal = p.normal;
+          if (s == 0) g = PixelGuide(), g.albedo = p.reflectance, g.normal = p.normal;
           g.direct += p.radiance;
           g.emitted += p.emitted;
         }

@@ -153,6 +153,30 @@ __device__ inline void countInWarp(unsigned* counter, bool flag) {
   unsigned lane = (threadIdx.z * blockDim.y * blockDim.x + threadIdx.y * blockDim.x + threadIdx.x) & 31u;
   if (lane == unsigned(__ffs(int(active)) - 1) && set) atomicAdd(counter, unsigned(__popc(int(set))));
 }
+
+// Appends `item` to list[*count] where `flag` is set, one atomic per block of `Threads` threads
+// (every thread of the block must call it): a block's items stay together and in thread order, so
+// that a kernel over the list sees the block's neighbourhood (a tile of pixels) together.
+template <int Threads>
+__device__ inline void appendInBlock(uint32_t* list, unsigned* count, bool flag, uint32_t item) {
+  static_assert(Threads % 32 == 0, "whole warps");
+  constexpr int kWarps = Threads / 32;
+  __shared__ unsigned warpStart[kWarps + 1];
+  const unsigned thread = (threadIdx.z * blockDim.y + threadIdx.y) * blockDim.x + threadIdx.x;
+  const unsigned warp = thread / 32, lane = thread % 32;
+  const unsigned set = __ballot_sync(0xffffffffu, flag);
+  if (lane == 0) warpStart[warp + 1] = unsigned(__popc(int(set)));
+  __syncthreads();
+  if (thread == 0) {
+    warpStart[0] = 0;
+    for (int w = 1; w <= kWarps; ++w) warpStart[w] += warpStart[w - 1];
+    const unsigned total = warpStart[kWarps];
+    // The block's first slot, kept in the last entry's place once the sum is read.
+    warpStart[kWarps] = total ? atomicAdd(count, total) : 0u;
+  }
+  __syncthreads();
+  if (flag) list[warpStart[kWarps] + warpStart[warp] + unsigned(__popc(int(set & ((1u << lane) - 1u))))] = item;
+}
 #endif
 
 }  // namespace pvr::cuda

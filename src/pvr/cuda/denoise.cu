@@ -16,34 +16,13 @@ __device__ inline bool blockPixel(const EyeCamera& c, int& x, int& y) {
   return x < c.width && y < c.height;
 }
 
-// Appends the pixel to list[*count] where `flag` is set, one atomic per block: a block's pixels
-// (a 16x16 tile) stay together and in order, so a block of the later passes reads the same tile's
-// neighbourhood as a block over the whole image would.
-__device__ inline void appendInBlock(uint32_t* list, unsigned* count, bool flag, uint32_t pixel) {
-  constexpr int kWarps = kBlock * kBlock / 32;
-  __shared__ unsigned warpStart[kWarps + 1];
-  const unsigned thread = threadIdx.y * blockDim.x + threadIdx.x, warp = thread / 32, lane = thread % 32;
-  const unsigned set = __ballot_sync(0xffffffffu, flag);
-  if (lane == 0) warpStart[warp + 1] = unsigned(__popc(int(set)));
-  __syncthreads();
-  if (thread == 0) {
-    warpStart[0] = 0;
-    for (int w = 1; w <= kWarps; ++w) warpStart[w] += warpStart[w - 1];
-    const unsigned total = warpStart[kWarps];
-    // The block's first slot, kept in the last entry's place once the sum is read.
-    warpStart[kWarps] = total ? atomicAdd(count, total) : 0u;
-  }
-  __syncthreads();
-  if (flag) list[warpStart[kWarps] + warpStart[warp] + unsigned(__popc(int(set & ((1u << lane) - 1u))))] = pixel;
-}
-
 __global__ void __launch_bounds__(kBlock * kBlock) accumulateKernel(DenoiseFrameView v, uint32_t* filtered,
                                                                      unsigned* filteredCount) {
   int x, y;
   const bool inside = blockPixel(v.camera, x, y);
   const size_t pixel = inside ? denoisePixel(v.camera, x, y) : 0;
   if (inside) accumulateDenoisePixel(v, x, y);
-  appendInBlock(filtered, filteredCount, inside && filtersPixel(v, pixel), uint32_t(pixel));
+  appendInBlock<kBlock * kBlock>(filtered, filteredCount, inside && filtersPixel(v, pixel), uint32_t(pixel));
 }
 
 // The later passes: a grid-stride loop over the listed pixels.

@@ -40,7 +40,7 @@ __device__ inline void recordGuide(const EyeOutputs& out, size_t pixel, const Ga
   storeSample(out.emitted, pixel, p.emitted, sample, samples);
   storeSample(out.direct, pixel, p.radiance, sample, samples);
   if (sample > 0) return;
-  out.albedo[pixel] = p.demodulationAlbedo();
+  out.albedo[pixel] = p.reflectance;
   out.normal[pixel] = p.normal;
 }
 

@@ -60,6 +60,60 @@ __global__ void __launch_bounds__(kTile* kTile, 6) eyeRaysKernel(SceneView scene
   if (sample == 0) recordPixel(out, pixel, state);
 }
 
+// A reusing right eye under gather, first part (its first hits traced or rasterised already): each
+// pixel's reuse decision; a reused pixel takes the left eye's colour here, the others are listed
+// (by 8x8 tiles) for listedEyeRaysKernel. Over every pixel, the eye-rays kernel's warps waited on
+// their few unreused pixels (14 % occupancy on Sibenik, ncu, H100). Later samples read sample 0's
+// decision; the list stays.
+__global__ void __launch_bounds__(kTile* kTile) reuseDecisionKernel(SceneView scene, SceneIntersector sceneIntersector,
+                                                                     GatherParams params, EyeCamera camera, Eye eye,
+                                                                     int sample, StereoReuseView reuse,
+                                                                     GatherPointStore points, EyeOutputs out,
+                                                                     uint32_t* shadeList, unsigned* shadeCount) {
+  const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  int x, y;
+  const bool inside = tilePixel(camera.width, camera.height, x, y);
+  const size_t pixel = inside ? size_t(y) * camera.width + x : 0;
+  bool shade = false;
+  if (inside) {
+    PixelSample state;
+    if (sample > 0) {
+      state.reusedFrom = out.reusedFrom[pixel];
+    } else {
+      CounterRng rng(0, 0, 0);
+      const Ray ray = pixelSampleRay(params, camera, eye, x, y, 0, rng);
+      recordFirstHit(scene, camera, ray, sampleZeroFirstHit(scene, intersector, params, x, y, ray), reuse, state);
+      recordPixel(out, pixel, state);
+    }
+    if (state.reusedFrom != kNotReused) {
+      GatherPoint reused;
+      reused.radiance = reuse.sourceImage[state.reusedFrom];
+      points.store(pixel, reused);
+      recordGuide(out, pixel, reused, sample, params.samplesPerPixel);
+    }
+    shade = state.reusedFrom == kNotReused;
+  }
+  if (sample == 0) appendInBlock<kTile * kTile>(shadeList, shadeCount, shade, uint32_t(pixel));
+}
+
+// A reusing right eye under gather, second part: the listed pixels, shaded as an eye of its own
+// would (the decision is made; the random numbers are separate rendering's).
+__global__ void __launch_bounds__(kTile* kTile, 6) listedEyeRaysKernel(SceneView scene, SceneIntersector sceneIntersector,
+                                                                      GatherParams params, EyeCamera camera, Eye eye,
+                                                                      int sample, GatherPointStore points, EyeOutputs out,
+                                                                      const uint32_t* shadeList, const unsigned* shadeCount) {
+  const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
+  const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= *shadeCount) return;
+  const uint32_t pixel = shadeList[i];
+  const int x = int(pixel % unsigned(camera.width)), y = int(pixel / unsigned(camera.width));
+  PixelSample state;
+  const GatherPoint point =
+      pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, StereoReuseView(), state);
+  points.store(pixel, point);
+  recordGuide(out, pixel, point, sample, params.samplesPerPixel);
+}
+
 // Deferred shadows, first run (photon/deferred_shadows.h): the eye-rays kernel's gathering code,
 // its shading thrown away, to record the shadow queries it asks.
 template <StereoRole R>
@@ -154,7 +208,7 @@ StereoReuseView GpuEyePass::prepareReuse(const EyePass& pass, cudaStream_t strea
 size_t GpuEyePass::memoryBytes() const {
   size_t bytes = points_.bytes() + firstHits_.bytes() + shadowQueries_.bytes() + shadowsAsked_.bytes() +
                  shadowsBlocked_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
-                 reusedCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
+                 reusedCount_.bytes() + shadeList_.bytes() + shadeCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
                  vertexList_.bytes() + vertexCount_.bytes() + vertexPoints_.bytes() + vertexColours_.bytes() +
                  vertexInverseDepths_.bytes();
   for (int i = 0; i < 2; ++i)
@@ -234,6 +288,15 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
     temp_.reserve(bytes, "gather-point selection scratch");
   }
   const bool deferred = pass.raySchedule == RaySchedule::Deferred;
+  // A reusing right eye under gather whose first hits come from a pre-pass shades over a list of
+  // the pixels it does not reuse.
+  const bool listed = pass.role == StereoRole::Reuser && pass.reuse == StereoMode::Gather && !deferred &&
+                      !pass.foveated() && (params.primary.traced || params.primary.present());
+  if (listed) {
+    shadeList_.reserve(pixels, "right-eye pixels to shade");
+    shadeCount_.reserve(1, "right-eye pixels to shade");
+    PVR_CUDA_CHECK(cudaMemsetAsync(shadeCount_.data(), 0, sizeof(unsigned), stream));
+  }
   DeferredShadowsView shadows;
   if (deferred) {
     shadowQueries_.reserve(kMaxDeferredShadows * pixels, "deferred shadow queries");
@@ -257,8 +320,18 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
         launch("shadow queries", shadowQueriesKernel, grid, dim3(kTile, kTile), 0, stream, scene.intersector, camera.width,
                camera.height, shadows);
       }
-      launch("eye rays", eyeRays, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream, scene.view,
-             scene.intersector, params, camera, eye, s, reuse, points_.view(), out, shadows);
+      if (listed) {
+        launch("reuse decisions", reuseDecisionKernel, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0,
+               stream, scene.view, scene.intersector, params, camera, eye, s, reuse, points_.view(), out,
+               shadeList_.data(), shadeCount_.data());
+        // As many blocks as the whole eye would take; those past the list's end return at once.
+        launch("eye rays (pixels not reused)", listedEyeRaysKernel, blocksFor(pixels, kTile * kTile),
+               unsigned(kTile * kTile), 0, stream, scene.view, scene.intersector, params, camera, eye, s,
+               points_.view(), out, shadeList_.data(), shadeCount_.data());
+      } else {
+        launch("eye rays", eyeRays, tileGrid(camera.width, camera.height), dim3(kTile, kTile), 0, stream, scene.view,
+               scene.intersector, params, camera, eye, s, reuse, points_.view(), out, shadows);
+      }
     }
     StageScope scope(clock, Stage::Density, e);
     if (cached) {

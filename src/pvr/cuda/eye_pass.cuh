@@ -155,6 +155,8 @@ class GpuEyePass {
   DeviceBuffer<uint64_t> scattered_;
   DeviceBuffer<uint32_t> reusedFrom_;
   DeviceBuffer<unsigned> reusedCount_;
+  DeviceBuffer<uint32_t> shadeList_;                     ///< gather's right eye: the pixels it does not reuse
+  DeviceBuffer<unsigned> shadeCount_;
   DeviceBuffer<uint32_t> estimateList_, estimateCount_;  ///< the right eye's points still to estimate
   DeviceBuffer<uint8_t> vertexUsed_;
   DeviceBuffer<uint32_t> vertexList_, vertexCount_;  ///< foveated: the vertices shaded (count per eye)

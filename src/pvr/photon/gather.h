@@ -104,7 +104,6 @@ struct GatherPoint {
   PVR_HOST_DEVICE Vec3 photonContribution(const Photon& p) const {
     return lobes == 0 ? p.power : bsdf.eval(wo, -p.direction, lobes) * p.power;
   }
-  PVR_HOST_DEVICE Vec3 demodulationAlbedo() const { return reflectance; }
 };
 
 // What the denoiser needs of a pixel besides its radiance: its emitted part (lights and sky seen,
@@ -576,6 +575,31 @@ PVR_HOST_DEVICE GatherPoint imagePositionGatherPoint(const SceneView& scene, con
   return traceToGatherPoint(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
 }
 
+// Sample 0's first hit of pixel (x, y) along its `ray`: from the first-hit pre-pass or the raster
+// G-buffer where the frame has one, else traced.
+template <class Intersector>
+PVR_HOST_DEVICE Hit sampleZeroFirstHit(const SceneView& scene, const Intersector& intersector,
+                                       const GatherParams& params, int x, int y, const Ray& ray) {
+  Hit first;
+  if (params.primary.traced)
+    first = params.primary.traced[size_t(y) * size_t(params.primary.width) + size_t(x)];
+  else if (!params.primary.present() || params.jitterFirstSample ||
+           !rasterisedFirstHit(scene, params.primary, x, y, ray, first))
+    intersector.intersect(ray, INFINITY, first);
+  return first;
+}
+
+// What sample 0's first hit decides for its pixel: its id and inverse depth, under gather reuse
+// the other eye's pixel it reuses (or kNotReused), and its surface record in `surfaceOut` if given.
+PVR_HOST_DEVICE inline void recordFirstHit(const SceneView& scene, const EyeCamera& camera, const Ray& ray,
+                                           const Hit& first, const StereoReuseView& reuse, PixelSample& pixel,
+                                           SurfaceRecord* surfaceOut = nullptr) {
+  pixel.firstPrim = first.primId;
+  pixel.inverseDepth = firstHitInverseDepth(camera, ray, first);
+  if (surfaceOut) *surfaceOut = surfaceRecordOf(scene, camera, ray, first);
+  if (reuse.mode == StereoMode::Gather) pixel.reusedFrom = gatherSource(reuse, surfaceRecordOf(scene, camera, ray, first));
+}
+
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
 // `pixel` (the first hit, and whether the pixel reuses the other eye's shading
 // (`reuse`)) and writes the pixel's surface record to `surfaceOut` if given (the left eye under
@@ -604,21 +628,11 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
   CounterRng rng(0, 0, 0);
   Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
   if (s > 0) return traceToGatherPoint(scene, intersector, params, ray, rng, nullptr, camera.pixelSpread());
-  Hit first;
-  if (params.primary.traced)
-    first = params.primary.traced[size_t(y) * size_t(params.primary.width) + size_t(x)];
-  else if (!params.primary.present() || params.jitterFirstSample ||
-           !rasterisedFirstHit(scene, params.primary, x, y, ray, first))
-    intersector.intersect(ray, INFINITY, first);
-  pixel.firstPrim = first.primId;
-  pixel.inverseDepth = firstHitInverseDepth(camera, ray, first);
-  if (surfaceOut) *surfaceOut = surfaceRecordOf(scene, camera, ray, first);
-  if (reuse.mode == StereoMode::Gather) {
-    pixel.reusedFrom = gatherSource(reuse, surfaceRecordOf(scene, camera, ray, first));
-    if (pixel.reusedFrom != kNotReused) {
-      reused.radiance = reuse.sourceImage[pixel.reusedFrom];
-      return reused;
-    }
+  const Hit first = sampleZeroFirstHit(scene, intersector, params, x, y, ray);
+  recordFirstHit(scene, camera, ray, first, reuse, pixel, surfaceOut);
+  if (pixel.reusedFrom != kNotReused) {
+    reused.radiance = reuse.sourceImage[pixel.reusedFrom];
+    return reused;
   }
   return traceToGatherPoint(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
 }
@@ -664,7 +678,7 @@ PVR_HOST_DEVICE PixelSample shadePixel(const SceneView& scene, const Intersector
     if (guideOut) {
       guide.direct += point.radiance;
       guide.emitted += point.emitted;
-      if (s == 0) guide.albedo = point.demodulationAlbedo(), guide.normal = point.normal;
+      if (s == 0) guide.albedo = point.reflectance, guide.normal = point.normal;
     }
     out.radiance += finishGather(map, point, params.density);
   }
