@@ -10,7 +10,10 @@ struct DenoiseParams {
   float sigmaLuminance = 4.0f;   ///< luminance edge-stopping, in local standard deviations
   float normalPower = 128.0f;    ///< normal edge-stopping: exp(-power (1 - cos))
   float depthTolerance = 0.02f;  ///< relative inverse-depth difference off the pixel's plane: another surface
-  bool bicubicHistory = true;    ///< a moving head's history read by Catmull-Rom where its 4x4 taps agree (else bilinear)
+  // A moving head's history read by Catmull-Rom where its taps agree (else bilinear). Off by
+  // default: on the H100 it cost 0.22 ms a stereo frame on Sponza for 3 % less error, and
+  // nothing on Cornell (docs/benchmarks.md, "The denoiser's history read").
+  bool bicubicHistory = false;
   // Progressive refinement while the head is still (within the tolerances below from the last
   // frame): the frames' signals are averaged with 1 / n (not the moving head's alpha floor), new
   // photons each frame with a radius shrinking by Knaus-Zwicker's rule (refineAlpha, down to
