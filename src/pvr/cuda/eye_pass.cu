@@ -208,7 +208,8 @@ StereoReuseView GpuEyePass::prepareReuse(const EyePass& pass, cudaStream_t strea
 size_t GpuEyePass::memoryBytes() const {
   size_t bytes = points_.bytes() + firstHits_.bytes() + shadowQueries_.bytes() + shadowsAsked_.bytes() +
                  shadowsBlocked_.bytes() + temp_.bytes() + surfaces_.bytes() + scattered_.bytes() + reusedFrom_.bytes() +
-                 reusedCount_.bytes() + shadeList_.bytes() + shadeCount_.bytes() + estimateList_.bytes() + estimateCount_.bytes() + vertexUsed_.bytes() +
+                 reusedCount_.bytes() + shadeList_.bytes() + shadeCount_.bytes() + estimateList_.bytes() +
+                 estimateCount_.bytes() + vertexUsed_.bytes() +
                  vertexList_.bytes() + vertexCount_.bytes() + vertexPoints_.bytes() + vertexColours_.bytes() +
                  vertexInverseDepths_.bytes();
   for (int i = 0; i < 2; ++i)
