@@ -48,6 +48,19 @@ struct Variant {
   StereoMode stereo = StereoMode::Separate;
   bool bicubicHistory = DenoiseParams().bicubicHistory;  ///< the denoiser's history read (--denoise-history)
   int iterations = DenoiseParams().iterations;           ///< a-trous passes (--denoise-iterations)
+  // The suite's options with this variant's (the moving and the still head both render from it).
+  RenderOptions options(const RenderOptions& suite) const {
+    RenderOptions o = suite;
+    o.denoise.enabled = denoise;
+    o.denoise.params.bicubicHistory = bicubicHistory;
+    o.denoise.params.iterations = iterations;
+    o.temporal.enabled = taa;
+    o.stereo = stereo;
+    o.photonBatches = photonBatches;
+    o.gather.sampling = sampling;
+    o.gather.density.boundary = boundary;
+    return o;
+  }
 };
 constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {"TAA", false, true, 1},
@@ -250,15 +263,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
     for (const Variant* variant : variants) {
       const Variant& v = *variant;
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
-      RenderOptions vo = o;
-      vo.denoise.enabled = v.denoise;
-      vo.denoise.params.bicubicHistory = v.bicubicHistory;
-      vo.denoise.params.iterations = v.iterations;
-      vo.temporal.enabled = v.taa;
-      vo.stereo = v.stereo;
-      vo.photonBatches = v.photonBatches;
-      vo.gather.sampling = v.sampling;
-      vo.gather.density.boundary = v.boundary;
+      const RenderOptions vo = v.options(o);
       renderer->setFreshNoisePerFrame(v.freshNoise);
       std::vector<double> denoiseMs, frameMs, relMse, ssim, flickers, referenceFlickers, unexplained;
       std::vector<std::array<Image, 2>> shown(sampled.size());
@@ -337,14 +342,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       // A still head reads its history at pixel centres, where both reads agree.
       if (v.bicubicHistory != DenoiseParams().bicubicHistory) continue;
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
-      RenderOptions vo = o;
-      vo.denoise.enabled = v.denoise;
-      vo.denoise.params.bicubicHistory = v.bicubicHistory;
-      vo.denoise.params.iterations = v.iterations;
-      vo.temporal.enabled = v.taa;
-      vo.stereo = v.stereo;
-      vo.gather.sampling = v.sampling;
-      vo.gather.density.boundary = v.boundary;
+      const RenderOptions vo = v.options(o);
       ReferenceError at[3];
       Image last, stillShown;
       std::vector<double> changes;  // after the still frames, moving: frame-to-frame change of the left eye
