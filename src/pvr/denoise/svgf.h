@@ -422,7 +422,7 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
       if (fabsf(fx - sx) < kTaaSnapPixels && fabsf(fy - sy) < kTaaSnapPixels) fx = sx, fy = sy;  // a still head
       const int x0 = int(floorf(fx)), y0 = int(floorf(fy));
       const float tx = fx - float(x0), ty = fy - float(y0);
-      // Each tap's guide and values are read before its test, from the nearest pixel inside the
+      // Each tap's guide and colours are read before its test, from the nearest pixel inside the
       // image (a tap outside has no weight): the four taps' loads go out together.
 #ifdef __CUDA_ARCH__
 #pragma unroll
