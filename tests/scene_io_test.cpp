@@ -2,6 +2,8 @@
 // every bad-input case at the library level: each must throw pvr::Error with a clear message.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <functional>
 
 #include "pvr/render/renderer.h"
@@ -100,6 +102,31 @@ TEST(SceneErrors, EachBadInputThrowsAClearError) {
     EXPECT_NE(message.find(c.expected), std::string::npos) << c.input << " gave: '" << message << "'";
     EXPECT_EQ(message.find('\n'), std::string::npos) << "one line";
   }
+}
+
+// JSON numbers outside the C++ type they fill: nlohmann's get<T>() would cast, which is undefined
+// (the sanitizer suite runs this). Scene files reject them by name; glTF extension values that
+// do not fit are dropped with the extensions, as assimp keeps the rest of the file.
+TEST(SceneErrors, NumbersOutsideTheirTypesAreRejectedNotCast) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "pvr_scene_numbers";
+  std::filesystem::create_directories(dir);
+  auto sceneWithCamera = [&](const std::string& name, const std::string& camera) {
+    const std::string path = (dir / name).string();
+    std::ofstream(path) << R"({"base": "cornell", "camera": )" << camera << "}";
+    return errorOf([&] { loadScene(path); });
+  };
+  EXPECT_NE(sceneWithCamera("ipd.json", R"({"ipd": 1e300})").find("camera.ipd must be finite"), std::string::npos);
+  EXPECT_NE(sceneWithCamera("pos.json", R"({"position": [0, -1e39, 0]})").find("must be finite"), std::string::npos);
+  for (const char* size : {"[1e300, 64]", "[-1, 64]", "[64, 4294967360]", "[64.5, 64]"})
+    EXPECT_NE(sceneWithCamera("size.json", std::string(R"({"eye_size": )") + size + "}").find("camera.eye_size must be"),
+              std::string::npos) << size;
+  EXPECT_EQ(sceneWithCamera("fine.json", R"({"eye_size": [64, 48]})"), "");
+  std::filesystem::remove_all(dir);
+
+  Scene s = loadScene(kData + "/../fuzz/regressions/mesh/gltf-numbers-outside-their-types.gltf");
+  EXPECT_EQ(s.triangleCount(), 8u);
+  const Vec3 emission = materialNamed(s, "floor").emission;  // factor 0.25, strength 1e300 dropped
+  EXPECT_TRUE(std::isfinite(emission.x) && emission.x <= 0.25f) << emission.x;
 }
 
 TEST(SceneErrors, BadRenderOptionsAreRejected) {

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "pvr/scene/scene.h"
@@ -39,9 +40,10 @@ using nlohmann::json;
 
 float number(const json& j, const std::string& what) {
   if (!j.is_number()) throw Error(what + " must be a number");
-  float v = j.get<float>();
-  if (!std::isfinite(v)) throw Error(what + " must be finite");
-  return v;
+  // Checked as a double: nlohmann's get<float>() would cast, undefined past float's range.
+  const double v = j.get<double>();
+  if (!(std::abs(v) <= double(std::numeric_limits<float>::max()))) throw Error(what + " must be finite");
+  return float(v);
 }
 
 Vec3 vec3(const json& j, const std::string& what) {
@@ -96,10 +98,11 @@ void applyCamera(const json& cam, StereoRig& rig) {
   if (cam.contains("fov_right_deg")) rig.fov[1] = fovDegrees(cam["fov_right_deg"], "camera.fov_right_deg");
   if (cam.contains("eye_size")) {
     const json& s = cam["eye_size"];
-    if (!s.is_array() || s.size() != 2 || !s[0].is_number_integer() || !s[1].is_number_integer())
-      throw Error("camera.eye_size must be [width, height] in pixels");
-    rig.width = s[0].get<int>();
-    rig.height = s[1].get<int>();
+    auto pixels = [](const json& n) { return n.is_number_unsigned() && n.get<uint64_t>() <= 65536; };
+    if (!s.is_array() || s.size() != 2 || !pixels(s[0]) || !pixels(s[1]))
+      throw Error("camera.eye_size must be [width, height] in pixels (at most 65536)");
+    rig.width = int(s[0].get<uint64_t>());
+    rig.height = int(s[1].get<uint64_t>());
   }
 }
 
