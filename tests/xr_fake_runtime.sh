@@ -38,6 +38,25 @@ else
   echo "ok   (keys 2, e, 0 applied on successive frames: shadows, reflections, the scene's own levels)"
 fi
 
+# Controller buttons through OpenXR actions (the test runtime has a simple controller in each
+# hand): right select held on frames 3-4 (one press), pressed again on 6, left select on 8: every
+# material at raster, then shadows, then the scene's own levels; all five core profiles bound.
+right=/user/hand/right/input/select/click left=/user/hand/left/input/select/click
+PVR_FAKE_XR=ok PVR_FAKE_XR_PRESS="3:$right,4:$right,6:$right,8:$left" timeout 120 "$exe" xr "${small[@]}" --frames 12 \
+  --stats "$out/buttons.json" >"$out/buttons.log" 2>"$out/buttons.err"
+rc=$?
+presses=$(grep -o "controller (.*" "$out/buttons.log" | tr '\n' '|')
+flat=$(tr -d ' \n' <"$out/buttons.json" 2>/dev/null)
+if [ $rc -ne 0 ] || [ -s "$out/buttons.err" ] ||
+   [ "$presses" != "controller (next level): every material at raster|controller (next level): every material at shadows|controller (the scene's levels): each material at its own level|" ] ||
+   ! grep -q '"controller_presses":3,' <<<"$flat" || ! grep -q '"controller_profiles":5,' <<<"$flat" ||
+   ! grep -q '"effects":"permaterial"' <<<"$flat"; then
+  echo "FAIL (controller): exit $rc, presses '$presses', stderr: $(cat "$out/buttons.err")"
+  failures=$((failures + 1))
+else
+  echo "ok   (controller buttons: held over two frames counts once; raster, shadows, the scene's own levels)"
+fi
+
 expect_error() {  # mode, expected-substring, extra arguments...
   local mode=$1 expected=$2
   shift 2

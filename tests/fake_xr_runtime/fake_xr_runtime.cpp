@@ -4,6 +4,9 @@
 //   ok (default) | noext (no XR_KHR_vulkan_enable2) | nohmd (no headset) | binding (the graphics
 //   binding is refused) | formats (no usable swapchain format) | noready (READY never comes) |
 //   lost (LOSS_PENDING after 5 frames) | norelease (swapchain images are never released)
+// Input: actions with a khr/simple_controller in each hand. PVR_FAKE_XR_PRESS holds the buttons
+// down, "FRAME:PATH,..." (e.g. "3:/user/hand/right/input/select/click"): that input path is down
+// for the frame FRAME (counted by xrWaitFrame from 1); a path on successive frames is held.
 // The loader finds it through XR_RUNTIME_JSON. The negotiation structs are declared here from the
 // OpenXR loader specification (Debian's headers do not ship them).
 #include <vulkan/vulkan.h>
@@ -13,9 +16,11 @@
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,7 +55,19 @@ struct Swapchain {
   uint32_t next = 0;
 };
 
+struct Action {
+  XrActionType type;
+  uint64_t set;
+  std::vector<XrPath> bindings;  // on the simple controller
+  bool down = false, changed = false;
+};
+
 struct State {
+  std::vector<std::string> paths = {""};  // XrPath n is paths[n]; 0 is XR_NULL_PATH
+  std::map<uint64_t, Action> actions;
+  std::map<uint64_t, bool> actionSets;  // attached?
+  bool attached = false;
+  int waitedFrames = 0;
   VkInstance vkInstance = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
   VkDevice device = VK_NULL_HANDLE;
@@ -297,6 +314,7 @@ XRAPI_ATTR XrResult XRAPI_CALL endSession(XrSession) {
 
 XRAPI_ATTR XrResult XRAPI_CALL waitFrame(XrSession, const XrFrameWaitInfo*, XrFrameState* state) {
   if (g.lossSent) return XR_ERROR_SESSION_LOST;
+  ++g.waitedFrames;
   state->predictedDisplayPeriod = 11'111'111;
   state->predictedDisplayTime = nowNs() + 2 * state->predictedDisplayPeriod;
   state->shouldRender = XR_TRUE;
@@ -330,6 +348,137 @@ XRAPI_ATTR XrResult XRAPI_CALL locateViews(XrSession, const XrViewLocateInfo*, X
 XRAPI_ATTR XrResult XRAPI_CALL timeToTimespec(XrInstance, XrTime time, timespec* ts) {
   ts->tv_sec = time / 1000000000;
   ts->tv_nsec = time % 1000000000;
+  return XR_SUCCESS;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL stringToPath(XrInstance, const char* text, XrPath* path) {
+  if (!text || text[0] != '/') return XR_ERROR_PATH_FORMAT_INVALID;
+  for (size_t i = 1; i < g.paths.size(); ++i)
+    if (g.paths[i] == text) return *path = XrPath(i), XR_SUCCESS;
+  g.paths.push_back(text);
+  *path = XrPath(g.paths.size() - 1);
+  return XR_SUCCESS;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL pathToString(XrInstance, XrPath path, uint32_t capacity, uint32_t* count, char* out) {
+  if (path == XR_NULL_PATH || path >= g.paths.size()) return XR_ERROR_PATH_INVALID;
+  const std::string& text = g.paths[path];
+  *count = uint32_t(text.size() + 1);
+  if (capacity == 0) return XR_SUCCESS;
+  if (capacity < *count) return XR_ERROR_SIZE_INSUFFICIENT;
+  std::memcpy(out, text.c_str(), *count);
+  return XR_SUCCESS;
+}
+
+std::string pathText(XrPath path) { return path < g.paths.size() ? g.paths[path] : ""; }
+
+XRAPI_ATTR XrResult XRAPI_CALL createActionSet(XrInstance, const XrActionSetCreateInfo* info, XrActionSet* set) {
+  if (g.attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
+  if (!info->actionSetName[0]) return XR_ERROR_NAME_INVALID;
+  uint64_t handle = g.nextHandle++;
+  g.actionSets[handle] = false;
+  *set = reinterpret_cast<XrActionSet>(uintptr_t(handle));
+  return XR_SUCCESS;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL destroyActionSet(XrActionSet set) {
+  const uint64_t handle = uint64_t(reinterpret_cast<uintptr_t>(set));
+  if (!g.actionSets.erase(handle)) return XR_ERROR_HANDLE_INVALID;
+  for (auto it = g.actions.begin(); it != g.actions.end();) it = it->second.set == handle ? g.actions.erase(it) : std::next(it);
+  return XR_SUCCESS;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL createAction(XrActionSet set, const XrActionCreateInfo* info, XrAction* action) {
+  const uint64_t owner = uint64_t(reinterpret_cast<uintptr_t>(set));
+  if (!g.actionSets.count(owner)) return XR_ERROR_HANDLE_INVALID;
+  if (g.actionSets[owner]) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
+  if (!info->actionName[0]) return XR_ERROR_NAME_INVALID;
+  uint64_t handle = g.nextHandle++;
+  g.actions[handle] = Action{info->actionType, owner, {}};
+  *action = reinterpret_cast<XrAction>(uintptr_t(handle));
+  return XR_SUCCESS;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL destroyAction(XrAction action) {
+  return g.actions.erase(uint64_t(reinterpret_cast<uintptr_t>(action))) ? XR_SUCCESS : XR_ERROR_HANDLE_INVALID;
+}
+
+// The OpenXR 1.0 core profiles are accepted (the spec requires it); only the simple controller's
+// bindings take effect, as on a runtime with those controllers in hand.
+XRAPI_ATTR XrResult XRAPI_CALL suggestBindings(XrInstance, const XrInteractionProfileSuggestedBinding* info) {
+  const std::string profile = pathText(info->interactionProfile);
+  static const char* known[] = {"/interaction_profiles/khr/simple_controller", "/interaction_profiles/oculus/touch_controller",
+                                "/interaction_profiles/valve/index_controller", "/interaction_profiles/htc/vive_controller",
+                                "/interaction_profiles/microsoft/motion_controller"};
+  if (std::find(std::begin(known), std::end(known), profile) == std::end(known)) return XR_ERROR_PATH_UNSUPPORTED;
+  if (g.attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
+  const bool simple = profile == known[0];
+  for (uint32_t i = 0; i < info->countSuggestedBindings; ++i) {
+    const XrActionSuggestedBinding& b = info->suggestedBindings[i];
+    auto it = g.actions.find(uint64_t(reinterpret_cast<uintptr_t>(b.action)));
+    const std::string where = pathText(b.binding);
+    if (it == g.actions.end()) return XR_ERROR_HANDLE_INVALID;
+    if (where.rfind("/user/hand/left/input/", 0) != 0 && where.rfind("/user/hand/right/input/", 0) != 0) return XR_ERROR_PATH_UNSUPPORTED;
+    if (simple) {
+      const bool click = where.size() > 13 && where.compare(where.size() - 13, 13, "/select/click") == 0;
+      if (!click && where.find("/pose") == std::string::npos) return XR_ERROR_PATH_UNSUPPORTED;  // select, menu, poses
+      it->second.bindings.push_back(b.binding);
+    }
+  }
+  return XR_SUCCESS;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL attachActionSets(XrSession, const XrSessionActionSetsAttachInfo* info) {
+  if (g.attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
+  for (uint32_t i = 0; i < info->countActionSets; ++i) {
+    auto it = g.actionSets.find(uint64_t(reinterpret_cast<uintptr_t>(info->actionSets[i])));
+    if (it == g.actionSets.end()) return XR_ERROR_HANDLE_INVALID;
+    it->second = true;
+  }
+  g.attached = true;
+  return XR_SUCCESS;
+}
+
+// Whether PVR_FAKE_XR_PRESS holds `path` down in the frame waited for last.
+bool held(const std::string& path) {
+  const char* spec = std::getenv("PVR_FAKE_XR_PRESS");
+  std::string list = spec ? spec : "";
+  for (size_t start = 0; start < list.size();) {
+    size_t end = list.find(',', start);
+    if (end == std::string::npos) end = list.size();
+    const std::string item = list.substr(start, end - start);
+    const size_t colon = item.find(':');
+    if (colon != std::string::npos && std::atoi(item.c_str()) == g.waitedFrames && item.substr(colon + 1) == path) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL syncActions(XrSession, const XrActionsSyncInfo* info) {
+  for (uint32_t i = 0; i < info->countActiveActionSets; ++i) {
+    auto it = g.actionSets.find(uint64_t(reinterpret_cast<uintptr_t>(info->activeActionSets[i].actionSet)));
+    if (it == g.actionSets.end()) return XR_ERROR_HANDLE_INVALID;
+    if (!it->second) return XR_ERROR_ACTIONSET_NOT_ATTACHED;
+  }
+  for (auto& [handle, action] : g.actions) {
+    if (action.type != XR_ACTION_TYPE_BOOLEAN_INPUT) continue;
+    bool down = false;
+    for (XrPath p : action.bindings) down = down || held(pathText(p));
+    action.changed = down != action.down;
+    action.down = down;
+  }
+  return XR_SUCCESS;
+}
+
+XRAPI_ATTR XrResult XRAPI_CALL getBoolean(XrSession, const XrActionStateGetInfo* info, XrActionStateBoolean* state) {
+  auto it = g.actions.find(uint64_t(reinterpret_cast<uintptr_t>(info->action)));
+  if (it == g.actions.end()) return XR_ERROR_HANDLE_INVALID;
+  if (it->second.type != XR_ACTION_TYPE_BOOLEAN_INPUT) return XR_ERROR_ACTION_TYPE_MISMATCH;
+  if (!g.actionSets[it->second.set]) return XR_ERROR_ACTIONSET_NOT_ATTACHED;
+  state->isActive = it->second.bindings.empty() ? XR_FALSE : XR_TRUE;
+  state->currentState = it->second.down ? XR_TRUE : XR_FALSE;
+  state->changedSinceLastSync = it->second.changed ? XR_TRUE : XR_FALSE;
+  state->lastChangeTime = nowNs();
   return XR_SUCCESS;
 }
 
@@ -369,6 +518,16 @@ XRAPI_ATTR XrResult XRAPI_CALL getInstanceProcAddr(XrInstance, const char* name,
       PVR_FAKE("xrEndFrame", endFrame),
       PVR_FAKE("xrLocateViews", locateViews),
       PVR_FAKE("xrConvertTimeToTimespecTimeKHR", timeToTimespec),
+      PVR_FAKE("xrStringToPath", stringToPath),
+      PVR_FAKE("xrPathToString", pathToString),
+      PVR_FAKE("xrCreateActionSet", createActionSet),
+      PVR_FAKE("xrDestroyActionSet", destroyActionSet),
+      PVR_FAKE("xrCreateAction", createAction),
+      PVR_FAKE("xrDestroyAction", destroyAction),
+      PVR_FAKE("xrSuggestInteractionProfileBindings", suggestBindings),
+      PVR_FAKE("xrAttachSessionActionSets", attachActionSets),
+      PVR_FAKE("xrSyncActions", syncActions),
+      PVR_FAKE("xrGetActionStateBoolean", getBoolean),
 #undef PVR_FAKE
   };
   auto it = table.find(name);

@@ -259,6 +259,9 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
                 info.colourFormat.c_str(), info.depthLayer ? "on" : "off", info.eyeTracker ? "yes" : "no (gaze from --gaze)");
     std::printf("  %s backend (%s), hand-over %s, %s space\n", renderer.backendName().c_str(), renderer.deviceName().c_str(),
                 info.handOver.c_str(), info.space.c_str());
+    if (info.controllerProfiles)
+      std::printf("  controllers: right select, A or trackpad: every material at the next effect level; left select or\n"
+                  "  trackpad, or B: the scene's own levels\n");
     std::optional<FoveationMask> controlMask;
     std::unique_ptr<BudgetController> controller = makeBudgetController(
         parseBudget(args.budget), args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);
@@ -272,6 +275,8 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     run["depth_layer"] = info.depthLayer;
     run["eye_tracker"] = info.eyeTracker;
     run["gaze_frames_tracked"] = presenter.gazeFramesTracked();
+    run["controller_profiles"] = info.controllerProfiles;
+    run["controller_presses"] = presenter.controllerPresses();
     run["handover"] = info.handOver;
     run["display_time_known"] = info.displayTimeKnown;
     run["focus_changes"] = presenter.lifecycle().focusChanges();

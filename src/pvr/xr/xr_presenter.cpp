@@ -12,9 +12,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <thread>
 #include <vector>
 
+#include "pvr/loop/loop_keys.h"
 #include "pvr/util/error.h"
 #include "pvr/vk/eye_transfer.h"
 #include "pvr/vk/frame_source.h"
@@ -72,6 +74,28 @@ struct Swapchain {
   std::vector<XrSwapchainImageVulkan2KHR> images;
 };
 
+// Where the two effect-level buttons sit on the controllers of the OpenXR 1.0 core profiles: the
+// right hand steps to the next level, the other button returns to the scene's own levels. The
+// runtime maps whichever controller is in hand onto one of these.
+struct ControllerBinding {
+  const char *profile, *nextLevel, *sceneLevels;
+};
+constexpr ControllerBinding kControllerBindings[] = {
+    {"/interaction_profiles/khr/simple_controller", "/user/hand/right/input/select/click", "/user/hand/left/input/select/click"},
+    {"/interaction_profiles/oculus/touch_controller", "/user/hand/right/input/a/click", "/user/hand/right/input/b/click"},
+    {"/interaction_profiles/valve/index_controller", "/user/hand/right/input/a/click", "/user/hand/right/input/b/click"},
+    {"/interaction_profiles/htc/vive_controller", "/user/hand/right/input/trackpad/click", "/user/hand/left/input/trackpad/click"},
+    {"/interaction_profiles/microsoft/motion_controller", "/user/hand/right/input/trackpad/click",
+     "/user/hand/left/input/trackpad/click"},
+};
+
+// A boolean action and the loop key its press stands for (pvr/loop/loop_keys.h).
+struct Button {
+  XrAction action = XR_NULL_HANDLE;
+  char key = 0;
+  const char* name = "";
+};
+
 }  // namespace
 
 struct XrPresenter::Impl {
@@ -86,11 +110,16 @@ struct XrPresenter::Impl {
   Swapchain colour[2], depth[2];
   bool depthLayer = false;
   int width = 0, height = 0;
-  // Eye gaze (XR_EXT_eye_gaze_interaction)
-  XrActionSet gazeSet = XR_NULL_HANDLE;
+  // Input, in one action set (a session attaches its sets once): the eye gaze pose
+  // (XR_EXT_eye_gaze_interaction) and the effect-level buttons.
+  XrActionSet inputSet = XR_NULL_HANDLE;
   XrAction gazeAction = XR_NULL_HANDLE;
   XrSpace gazeSpace = XR_NULL_HANDLE;
   int gazeFramesTracked = 0;
+  Button buttons[2];
+  std::deque<Button> presses;  ///< seen at the frame's sync, applied by adjustOptions
+  int controllerPresses = 0;
+  uint64_t frames = 0;
   PFN_xrConvertTimeToTimespecTimeKHR toTimespec = nullptr;
   // The frame in flight
   bool frameBegun = false;
@@ -104,7 +133,7 @@ struct XrPresenter::Impl {
     for (Swapchain* s : {&colour[0], &colour[1], &depth[0], &depth[1]})
       if (s->handle) xrDestroySwapchain(s->handle);
     if (gazeSpace) xrDestroySpace(gazeSpace);
-    if (gazeSet) xrDestroyActionSet(gazeSet);
+    if (inputSet) xrDestroyActionSet(inputSet);  // and its actions
     if (space) xrDestroySpace(space);
     if (session) xrDestroySession(session);
     vulkan.reset();  // made through the runtime: destroyed before the instance that made it
@@ -150,6 +179,77 @@ struct XrPresenter::Impl {
   void release(Swapchain& s) {
     XrSwapchainImageReleaseInfo info{XR_TYPE_SWAPCHAIN_IMAGE_RELEASE_INFO};
     xrCheck(xrReleaseSwapchainImage(s.handle, &info), "xrReleaseSwapchainImage");
+  }
+
+  XrPath path(const char* text) const {
+    XrPath p = XR_NULL_PATH;
+    xrCheck(xrStringToPath(instance, text, &p), "xrStringToPath");
+    return p;
+  }
+
+  XrAction makeAction(XrActionType type, const char* name, const char* localized) {
+    XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
+    aci.actionType = type;
+    std::strncpy(aci.actionName, name, XR_MAX_ACTION_NAME_SIZE - 1);
+    std::strncpy(aci.localizedActionName, localized, XR_MAX_LOCALIZED_ACTION_NAME_SIZE - 1);
+    XrAction action = XR_NULL_HANDLE;
+    xrCheck(xrCreateAction(inputSet, &aci, &action), "xrCreateAction");
+    return action;
+  }
+
+  // The action set: the gaze pose where there is an eye tracker, the buttons unless turned off.
+  // A runtime that takes no controller binding leaves the levels to the keys (with a warning).
+  void setUpInput(XrSessionInfo& info) {
+    if (!info.eyeTracker && !options.controllerLevels) return;
+    XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
+    std::strcpy(asci.actionSetName, "photonvr");
+    std::strcpy(asci.localizedActionSetName, "photonvr");
+    xrCheck(xrCreateActionSet(instance, &asci, &inputSet), "xrCreateActionSet");
+    auto suggest = [&](const char* profile, const std::vector<XrActionSuggestedBinding>& suggested) {
+      XrInteractionProfileSuggestedBinding bindings{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+      bindings.interactionProfile = path(profile);
+      bindings.countSuggestedBindings = uint32_t(suggested.size());
+      bindings.suggestedBindings = suggested.data();
+      return xrSuggestInteractionProfileBindings(instance, &bindings);
+    };
+    if (info.eyeTracker) {
+      gazeAction = makeAction(XR_ACTION_TYPE_POSE_INPUT, "eye_gaze", "eye gaze");
+      xrCheck(suggest("/interaction_profiles/ext/eye_gaze_interaction", {{gazeAction, path("/user/eyes_ext/input/gaze_ext/pose")}}),
+              "xrSuggestInteractionProfileBindings (eye gaze)");
+    }
+    if (options.controllerLevels) {
+      buttons[0] = {makeAction(XR_ACTION_TYPE_BOOLEAN_INPUT, "next_effect_level", "next effect level"), 'e', "next level"};
+      buttons[1] = {makeAction(XR_ACTION_TYPE_BOOLEAN_INPUT, "scene_effect_levels", "the scene's effect levels"), '0',
+                    "the scene's levels"};
+      for (const ControllerBinding& b : kControllerBindings)
+        if (XR_SUCCEEDED(suggest(b.profile, {{buttons[0].action, path(b.nextLevel)}, {buttons[1].action, path(b.sceneLevels)}})))
+          ++info.controllerProfiles;
+      if (info.controllerProfiles == 0)
+        std::fprintf(stderr, "photonvr: warning: the OpenXR runtime took no controller bindings: effect levels from the keys only\n");
+    }
+    XrSessionActionSetsAttachInfo attach{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+    attach.countActionSets = 1;
+    attach.actionSets = &inputSet;
+    xrCheck(xrAttachSessionActionSets(session, &attach), "xrAttachSessionActionSets");
+    if (gazeAction) {
+      XrActionSpaceCreateInfo spaceInfo{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+      spaceInfo.action = gazeAction;
+      spaceInfo.poseInActionSpace.orientation.w = 1.0f;
+      xrCheck(xrCreateActionSpace(session, &spaceInfo, &gazeSpace), "xrCreateActionSpace");
+    }
+  }
+
+  // After a sync: each button that went down since the last one is queued as a press.
+  void readButtons() {
+    for (const Button& b : buttons) {
+      if (!b.action) continue;
+      XrActionStateGetInfo get{XR_TYPE_ACTION_STATE_GET_INFO};
+      get.action = b.action;
+      XrActionStateBoolean state{XR_TYPE_ACTION_STATE_BOOLEAN};
+      if (xrGetActionStateBoolean(session, &get, &state) == XR_SUCCESS && state.isActive && state.changedSinceLastSync &&
+          state.currentState)
+        presses.push_back(b);
+    }
   }
 
   std::optional<LoopClock::time_point> toSteady(XrTime time) const {
@@ -368,34 +468,7 @@ XrPresenter::XrPresenter(const XrPresenterOptions& options) : impl_(std::make_un
   m.transfer = std::make_unique<EyeTransfer>(*m.vulkan, to);
   info_.handOver = m.transfer->describe();
 
-  if (info_.eyeTracker) {  // the gaze pose action of XR_EXT_eye_gaze_interaction
-    XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
-    std::strcpy(asci.actionSetName, "photonvr_gaze");
-    std::strcpy(asci.localizedActionSetName, "photonvr gaze");
-    xrCheck(xrCreateActionSet(m.instance, &asci, &m.gazeSet), "xrCreateActionSet");
-    XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
-    aci.actionType = XR_ACTION_TYPE_POSE_INPUT;
-    std::strcpy(aci.actionName, "eye_gaze");
-    std::strcpy(aci.localizedActionName, "eye gaze");
-    xrCheck(xrCreateAction(m.gazeSet, &aci, &m.gazeAction), "xrCreateAction");
-    XrPath profile, gazePath;
-    xrCheck(xrStringToPath(m.instance, "/interaction_profiles/ext/eye_gaze_interaction", &profile), "xrStringToPath");
-    xrCheck(xrStringToPath(m.instance, "/user/eyes_ext/input/gaze_ext/pose", &gazePath), "xrStringToPath");
-    XrActionSuggestedBinding suggested{m.gazeAction, gazePath};
-    XrInteractionProfileSuggestedBinding bindings{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
-    bindings.interactionProfile = profile;
-    bindings.countSuggestedBindings = 1;
-    bindings.suggestedBindings = &suggested;
-    xrCheck(xrSuggestInteractionProfileBindings(m.instance, &bindings), "xrSuggestInteractionProfileBindings (eye gaze)");
-    XrSessionActionSetsAttachInfo attach{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
-    attach.countActionSets = 1;
-    attach.actionSets = &m.gazeSet;
-    xrCheck(xrAttachSessionActionSets(m.session, &attach), "xrAttachSessionActionSets");
-    XrActionSpaceCreateInfo spaceInfo{XR_TYPE_ACTION_SPACE_CREATE_INFO};
-    spaceInfo.action = m.gazeAction;
-    spaceInfo.poseInActionSpace.orientation.w = 1.0f;
-    xrCheck(xrCreateActionSpace(m.session, &spaceInfo, &m.gazeSpace), "xrCreateActionSpace");
-  }
+  m.setUpInput(info_);
   m.waitingSince = LoopClock::now();
 }
 
@@ -408,6 +481,18 @@ FrameOutput XrPresenter::output(const Renderer& renderer) const {
 }
 
 int XrPresenter::gazeFramesTracked() const { return impl_->gazeFramesTracked; }
+
+int XrPresenter::controllerPresses() const { return impl_->controllerPresses; }
+
+void XrPresenter::adjustOptions(RenderOptions& options) {
+  Impl& m = *impl_;
+  if (m.presses.empty()) return;
+  const Button press = m.presses.front();
+  m.presses.pop_front();
+  ++m.controllerPresses;
+  std::printf("xr: frame %llu: controller (%s): %s\n", (unsigned long long)m.frames, press.name, applyLoopKey(press.key, options).c_str());
+  std::fflush(stdout);
+}
 
 void XrPresenter::requestStop() {
   Impl& m = *impl_;
@@ -486,14 +571,19 @@ bool XrPresenter::waitFrame(FrameRequest& request) {
   std::copy(&m.options.gaze[0][0], &m.options.gaze[0][0] + 4, &request.gaze[0][0]);
   request.verge = m.options.verge;
   request.gazeTracked = false;
-  if (m.gazeSpace && lifecycle_.focused() && m.viewsValid) {
-    XrActiveActionSet active{m.gazeSet, XR_NULL_PATH};
+  ++m.frames;
+  XrResult synced = XR_SESSION_NOT_FOCUSED;
+  if (m.inputSet && lifecycle_.focused()) {  // input reaches only the focused session
+    XrActiveActionSet active{m.inputSet, XR_NULL_PATH};
     XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
     sync.countActiveActionSets = 1;
     sync.activeActionSets = &active;
+    synced = xrSyncActions(m.session, &sync);
+    if (synced == XR_SUCCESS) m.readButtons();
+  }
+  if (m.gazeSpace && synced == XR_SUCCESS && m.viewsValid) {
     XrSpaceLocation location{XR_TYPE_SPACE_LOCATION};
-    if (xrSyncActions(m.session, &sync) == XR_SUCCESS &&
-        xrLocateSpace(m.gazeSpace, m.space, m.frameState.predictedDisplayTime, &location) == XR_SUCCESS &&
+    if (xrLocateSpace(m.gazeSpace, m.space, m.frameState.predictedDisplayTime, &location) == XR_SUCCESS &&
         (location.locationFlags & XR_SPACE_LOCATION_ORIENTATION_VALID_BIT)) {
       Pose gaze = composePoses(m.options.sceneFromSpace, poseFromXr(location.pose));
       float px = 0, py = 0;

@@ -21,6 +21,7 @@ struct XrPresenterOptions {
   bool stageSpace = false;           ///< STAGE reference space (floor level) instead of LOCAL (head at start)
   Pose sceneFromSpace;               ///< where the reference space's origin sits in the scene
   bool eyeGaze = true;               ///< use XR_EXT_eye_gaze_interaction when the system has an eye tracker
+  bool controllerLevels = true;      ///< controller buttons change the effect levels (as the keys e and 0)
   float gaze[2][2] = {{0.5f, 0.5f}, {0.5f, 0.5f}};  ///< otherwise this gaze (image fractions)
   bool verge = true;
   float exposure = 1.0f;
@@ -36,6 +37,7 @@ struct XrSessionInfo {
   std::string runtime, system, colourFormat, handOver, space;
   int eyeWidth = 0, eyeHeight = 0, recommendedWidth = 0, recommendedHeight = 0, maxWidth = 0, maxHeight = 0;
   bool depthLayer = false, eyeTracker = false, displayTimeKnown = false;
+  int controllerProfiles = 0;  ///< controller interaction profiles whose bindings the runtime took
   std::string vulkanDevice;
 };
 
@@ -54,10 +56,15 @@ class XrPresenter : public Presenter {
   bool waitFrame(FrameRequest& request) override;
   void present(const PresentedFrame& frame) override;
   void requestStop() override;
+  // Applies one controller press seen since the last frame (one a frame, as the keys): the
+  // right hand's select, A or trackpad puts every material at the next effect level, the left
+  // hand's select or trackpad (or B) gives each material its own level again.
+  void adjustOptions(RenderOptions& options) override;
 
   const XrSessionInfo& info() const { return info_; }
   const SessionLifecycle& lifecycle() const { return lifecycle_; }
   int gazeFramesTracked() const;
+  int controllerPresses() const;  ///< presses applied to the options
 
  private:
   struct Impl;
