@@ -86,8 +86,7 @@ __global__ void __launch_bounds__(kTile* kTile) reuseDecisionKernel(SceneView sc
       recordPixel(out, pixel, state);
     }
     if (state.reusedFrom != kNotReused) {
-      GatherPoint reused;
-      reused.radiance = reuse.sourceImage[state.reusedFrom];
+      const GatherPoint reused = reusedGatherPoint(reuse, state.reusedFrom);
       points.store(pixel, reused);
       recordGuide(out, pixel, reused, sample, params.samplesPerPixel);
     }

@@ -600,6 +600,13 @@ PVR_HOST_DEVICE inline void recordFirstHit(const SceneView& scene, const EyeCame
   if (reuse.mode == StereoMode::Gather) pixel.reusedFrom = gatherSource(reuse, surfaceRecordOf(scene, camera, ray, first));
 }
 
+// A reused pixel's gather point: the other eye's finished colour at its source pixel, no estimate.
+PVR_HOST_DEVICE inline GatherPoint reusedGatherPoint(const StereoReuseView& reuse, uint32_t source) {
+  GatherPoint reused;
+  reused.radiance = reuse.sourceImage[source];
+  return reused;
+}
+
 // Sample s of pixel (x, y), traced up to its gather point. Sample 0 (the pixel centre) fills in
 // `pixel` (the first hit, and whether the pixel reuses the other eye's shading
 // (`reuse`)) and writes the pixel's surface record to `surfaceOut` if given (the left eye under
@@ -612,7 +619,6 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
                                              const GatherParams& params, const EyeCamera& camera, Eye eye, int x,
                                              int y, int s, const StereoReuseView& reuse, PixelSample& pixel,
                                              SurfaceRecord* surfaceOut = nullptr) {
-  GatherPoint reused;
   if (s == 0 && reuse.mode == StereoMode::Scatter) {
     pixel.reusedFrom = scatteredSource(reuse.scattered[size_t(y) * camera.width + x]);
     if (pixel.reusedFrom != kNotReused) {
@@ -621,19 +627,13 @@ PVR_HOST_DEVICE GatherPoint pixelGatherPoint(const SceneView& scene, const Inter
       pixel.inverseDepth = camera.inverseDepthOf(source.position);
     }
   }
-  if (pixel.reusedFrom != kNotReused) {
-    reused.radiance = reuse.sourceImage[pixel.reusedFrom];
-    return reused;
-  }
+  if (pixel.reusedFrom != kNotReused) return reusedGatherPoint(reuse, pixel.reusedFrom);
   CounterRng rng(0, 0, 0);
   Ray ray = pixelSampleRay(params, camera, eye, x, y, s, rng);
   if (s > 0) return traceToGatherPoint(scene, intersector, params, ray, rng, nullptr, camera.pixelSpread());
   const Hit first = sampleZeroFirstHit(scene, intersector, params, x, y, ray);
   recordFirstHit(scene, camera, ray, first, reuse, pixel, surfaceOut);
-  if (pixel.reusedFrom != kNotReused) {
-    reused.radiance = reuse.sourceImage[pixel.reusedFrom];
-    return reused;
-  }
+  if (pixel.reusedFrom != kNotReused) return reusedGatherPoint(reuse, pixel.reusedFrom);
   return traceToGatherPoint(scene, intersector, params, ray, rng, &first, camera.pixelSpread());
 }
 
