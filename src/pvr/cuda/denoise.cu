@@ -1,6 +1,9 @@
 #include "pvr/cuda/denoise.cuh"
 
 #include <algorithm>
+#include <map>
+#include <mutex>
+#include <utility>
 
 #include "pvr/util/error.h"
 
@@ -97,12 +100,23 @@ __global__ void __launch_bounds__(kTile * kTile, 4)
   if (mine) atrousDenoisePixelOf<S>(v, iteration, levels, TileTaps<S>{guides, values, int(threadIdx.x), int(threadIdx.y)}, x, y);
 }
 
-// Blocks of a grid-stride kernel that fill every SM once (no partial last wave).
+// Blocks of a grid-stride kernel that fill every SM once (no partial last wave). The occupancy
+// and SM-count queries are host calls: made once per device and kernel, not every frame.
 template <class Kernel>
 unsigned residentBlocks(Kernel kernel, size_t items) {
-  int perSm = 0;
-  PVR_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perSm, kernel, int(kListThreads), 0));
-  return std::max(1u, std::min(blocksFor(items, kListThreads), unsigned(std::max(perSm, 1) * multiprocessorCount())));
+  static std::mutex mutex;
+  static std::map<std::pair<int, const void*>, unsigned> filling;  // (device, kernel): blocks
+  int device = 0;
+  PVR_CUDA_CHECK(cudaGetDevice(&device));
+  const std::pair<int, const void*> key(device, reinterpret_cast<const void*>(kernel));
+  std::lock_guard<std::mutex> lock(mutex);
+  auto found = filling.find(key);
+  if (found == filling.end()) {
+    int perSm = 0;
+    PVR_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perSm, kernel, int(kListThreads), 0));
+    found = filling.emplace(key, unsigned(std::max(perSm, 1) * multiprocessorCount())).first;
+  }
+  return std::max(1u, std::min(blocksFor(items, kListThreads), found->second));
 }
 
 __global__ void remodulateKernel(DenoiseFrameView v, const uint32_t* pixels, const unsigned* count) {
