@@ -57,6 +57,17 @@ else
   echo "ok   (controller buttons: held over two frames counts once; raster, shadows, the scene's own levels)"
 fi
 
+# A runtime that takes no controller binding: one warning line, and the session runs on.
+PVR_FAKE_XR=nocontrollers timeout 120 "$exe" xr "${small[@]}" --frames 4 --stats "$out/none.json" >"$out/none.log" 2>"$out/none.err"
+rc=$?
+if [ $rc -ne 0 ] || [ "$(wc -l <"$out/none.err")" -ne 1 ] || ! grep -q "took no controller bindings" "$out/none.err" ||
+   ! tr -d ' \n' <"$out/none.json" | grep -q '"controller_profiles":0,'; then
+  echo "FAIL (nocontrollers): exit $rc, stderr: $(cat "$out/none.err")"
+  failures=$((failures + 1))
+else
+  echo "ok   (nocontrollers): $(cat "$out/none.err")"
+fi
+
 expect_error() {  # mode, expected-substring, extra arguments...
   local mode=$1 expected=$2
   shift 2

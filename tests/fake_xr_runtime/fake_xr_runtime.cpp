@@ -3,7 +3,8 @@
 // each of photonvr's OpenXR errors can be provoked:
 //   ok (default) | noext (no XR_KHR_vulkan_enable2) | nohmd (no headset) | binding (the graphics
 //   binding is refused) | formats (no usable swapchain format) | noready (READY never comes) |
-//   lost (LOSS_PENDING after 5 frames) | norelease (swapchain images are never released)
+//   lost (LOSS_PENDING after 5 frames) | norelease (swapchain images are never released) |
+//   nocontrollers (no controller profile's bindings are taken)
 // Input: actions with a khr/simple_controller in each hand. PVR_FAKE_XR_PRESS holds the buttons
 // down, "FRAME:PATH,..." (e.g. "3:/user/hand/right/input/select/click"): that input path is down
 // for the frame FRAME (counted by xrWaitFrame from 1); a path on successive frames is held.
@@ -410,7 +411,8 @@ XRAPI_ATTR XrResult XRAPI_CALL suggestBindings(XrInstance, const XrInteractionPr
   static const char* known[] = {"/interaction_profiles/khr/simple_controller", "/interaction_profiles/oculus/touch_controller",
                                 "/interaction_profiles/valve/index_controller", "/interaction_profiles/htc/vive_controller",
                                 "/interaction_profiles/microsoft/motion_controller"};
-  if (std::find(std::begin(known), std::end(known), profile) == std::end(known)) return XR_ERROR_PATH_UNSUPPORTED;
+  if (std::find(std::begin(known), std::end(known), profile) == std::end(known) || mode() == "nocontrollers")
+    return XR_ERROR_PATH_UNSUPPORTED;
   if (g.attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
   const bool simple = profile == known[0];
   for (uint32_t i = 0; i < info->countSuggestedBindings; ++i) {
