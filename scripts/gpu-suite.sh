@@ -4,7 +4,8 @@
 # the CUDA-vs-CPU tests, every render mode, the GPU bad-input cases and injected faults (out of
 # memory at every allocation, a lost device) through the executable, and
 # compute-sanitizer (memcheck, racecheck, synccheck, initcheck) on representative render modes
-# (TAA with scatter reuse, foveated gather, denoised with a rolling photon map, the surface cache).
+# (TAA with scatter reuse, foveated gather, denoised with a rolling photon map, the surface cache,
+# the G-buffer pre-pass at the path level, and gather reuse over the pre-pass's first hits).
 #   usage: scripts/gpu-suite.sh BUNDLE_DIR LOG_DIR [--no-sanitizer]
 # Prints one line per part and exits non-zero if any part failed; the logs go to LOG_DIR.
 set -u
@@ -50,6 +51,11 @@ if [ "${3:-}" != --no-sanitizer ] && command -v compute-sanitizer >/dev/null; th
     # The G-buffer pre-pass (Vulkan memory CUDA imported; needs the Vulkan loader) and the path level.
     part "sanitizer_${tool}_raster" compute-sanitizer --tool "$tool" --error-exitcode 9 \
       "$bundle/photonvr" render cornell-caustics "${small[@]}" --primary raster --effects path --stereo gather \
+      --trajectory tests/data/gaze_pursuit.traj
+    # Gather reuse over the pre-pass's first hits: the right eye's reuse decisions, then its list of
+    # the pixels it shades itself (eye_pass.cu's listed path), denoised.
+    part "sanitizer_${tool}_listed" compute-sanitizer --tool "$tool" --error-exitcode 9 \
+      "$bundle/photonvr" render cornell "${small[@]}" --primary raster --stereo gather --denoise \
       --trajectory tests/data/gaze_pursuit.traj
   done
 fi
