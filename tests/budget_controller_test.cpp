@@ -358,6 +358,22 @@ TEST(BudgetController, ProfilesRoundTripAndBadOnesAreRefused) {
   j = p.toJson();
   j["error"]["photons"] = {0.1};
   EXPECT_TRUE(refused(j.dump()));
+  // Numbers the ladders' types do not hold: refused by name, never cast (a cast is undefined there).
+  for (const char* ladder : {"photon_sides", "denoise_iterations", "radius_scales"})
+    for (const double bad : {1e20, -1e300, 2.5}) {
+      const bool integers = std::string(ladder) != "radius_scales";
+      if (!integers && bad != -1e300) continue;  // floats that fit: the ladder's own range check's
+      j = p.toJson();
+      j[ladder][0] = bad;
+      std::ofstream(path) << j.dump();
+      try {
+        ControlProfile::load(path, {"rest", "floor"});
+        ADD_FAILURE() << ladder << " " << bad << " loaded";
+      } catch (const Error& e) {
+        const std::string expected = std::string("each of '") + ladder + (integers ? "' must be an integer" : "' must be a finite number");
+        EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      }
+    }
   j = p.toJson();
   j["error"]["groups"]["floor"]["sparkle"] = 1.0;
   EXPECT_TRUE(refused(j.dump()));

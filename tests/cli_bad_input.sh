@@ -178,6 +178,15 @@ echo '{"head": {"position": [0, 1, 2], "orientation": [0, 0, 0, 0]}}' >"$out/zer
 expect_error "non-zero quaternion" render --settings "$out/zero.json" "${small[@]}"
 echo '{"radius": "-1"}' >"$out/radius.json"
 expect_error "radius" render --settings "$out/radius.json" "${small[@]}"
+# Numbers outside the type they fill: an error naming the key, never a cast (undefined there).
+echo '{"k": 1e20}' >"$out/k.json"
+expect_error "k must be an integer" render --settings "$out/k.json" "${small[@]}"
+echo '{"denoise_iterations": 2.5}' >"$out/iterations.json"
+expect_error "denoise_iterations must be an integer" render --settings "$out/iterations.json" "${small[@]}"
+echo '{"exposure": 1e300}' >"$out/exposure.json"
+expect_error "exposure must be a finite number" render --settings "$out/exposure.json" "${small[@]}"
+echo '{"head": {"position": [0, 1e39, 0], "orientation": [0, 0, 0, 1]}}' >"$out/far.json"
+expect_error "the head pose must be a finite number" render --settings "$out/far.json" "${small[@]}"
 expect_error "--acuity must be" render cornell --foveated --acuity sharp "${small[@]}"
 
 # NaN vertices and degenerate triangles: a warning, and the render goes on.

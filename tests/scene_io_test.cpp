@@ -115,8 +115,8 @@ TEST(SceneErrors, NumbersOutsideTheirTypesAreRejectedNotCast) {
     std::ofstream(path) << R"({"base": "cornell", "camera": )" << camera << "}";
     return errorOf([&] { loadScene(path); });
   };
-  EXPECT_NE(sceneWithCamera("ipd.json", R"({"ipd": 1e300})").find("camera.ipd must be finite"), std::string::npos);
-  EXPECT_NE(sceneWithCamera("pos.json", R"({"position": [0, -1e39, 0]})").find("must be finite"), std::string::npos);
+  EXPECT_NE(sceneWithCamera("ipd.json", R"({"ipd": 1e300})").find("camera.ipd must be a finite number"), std::string::npos);
+  EXPECT_NE(sceneWithCamera("pos.json", R"({"position": [0, -1e39, 0]})").find("must be a finite number"), std::string::npos);
   for (const char* size : {"[1e300, 64]", "[-1, 64]", "[64, 4294967360]", "[64.5, 64]"})
     EXPECT_NE(sceneWithCamera("size.json", std::string(R"({"eye_size": )") + size + "}").find("camera.eye_size must be"),
               std::string::npos) << size;

@@ -30,6 +30,7 @@
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
 #include "pvr/util/fault_injection.h"
+#include "pvr/util/json_number.h"
 
 namespace pvr {
 namespace {
@@ -166,16 +167,17 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     flag("denoise", "--denoise", a.denoise);
     text("denoise_history", "--denoise-history", a.denoiseHistory);
     if (j.contains("denoise_iterations") && !given("--denoise-iterations"))
-      a.denoiseIterations = j["denoise_iterations"].get<int>();
-    if (j.contains("k") && !given("--k")) a.k = j["k"].get<int>();
-    if (j.contains("exposure") && !given("--exposure")) a.exposure = j["exposure"].get<float>();
+      a.denoiseIterations = jsonNumber<int>(j["denoise_iterations"], "denoise_iterations");
+    if (j.contains("k") && !given("--k")) a.k = jsonNumber<int>(j["k"], "k");
+    if (j.contains("exposure") && !given("--exposure")) a.exposure = jsonNumber<float>(j["exposure"], "exposure");
     if (j.contains("scene") && !given("scene")) a.scene = j["scene"].get<std::string>();
     if (j.contains("head")) {
       const auto& p = j["head"].at("position");
       const auto& q = j["head"].at("orientation");
       Pose head;
-      head.position = {p.at(0).get<float>(), p.at(1).get<float>(), p.at(2).get<float>()};
-      head.orientation = {q.at(0).get<float>(), q.at(1).get<float>(), q.at(2).get<float>(), q.at(3).get<float>()};
+      auto number = [](const nlohmann::json& n) { return jsonNumber<float>(n, "the head pose"); };
+      head.position = {number(p.at(0)), number(p.at(1)), number(p.at(2))};
+      head.orientation = {number(q.at(0)), number(q.at(1)), number(q.at(2)), number(q.at(3))};
       float n = std::sqrt(head.orientation.x * head.orientation.x + head.orientation.y * head.orientation.y +
                           head.orientation.z * head.orientation.z + head.orientation.w * head.orientation.w);
       if (!(n > 1e-6f) || !std::isfinite(n) || !std::isfinite(head.position.x + head.position.y + head.position.z))

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "pvr/util/error.h"
+#include "pvr/util/json_number.h"
 #include "pvr/util/latency_stats.h"
 
 namespace pvr {
@@ -37,7 +38,9 @@ template <class T>
 std::vector<T> readList(const nlohmann::json& j, const char* key, const std::vector<T>& fallback) {
   if (!j.contains(key)) return fallback;
   if (!j[key].is_array()) throw Error(std::string("'") + key + "' must be a list");
-  return j[key].get<std::vector<T>>();
+  std::vector<T> out;
+  for (const nlohmann::json& n : j[key]) out.push_back(jsonNumber<T>(n, std::string("each of '") + key + "'"));
+  return out;
 }
 
 std::array<double, kControlledLevels> readLevels(const nlohmann::json& j, const std::string& what) {

@@ -25,9 +25,7 @@
 #include <cctype>
 #include <cstring>
 #include <fstream>
-#include <limits>
 #include <optional>
-#include <stdexcept>
 #include <nlohmann/json.hpp>
 #include <assimp/Importer.hpp>
 #include <filesystem>
@@ -35,6 +33,7 @@
 #include "pvr/scene/scene.h"
 #include "pvr/scene/texture_file.h"
 #include "pvr/util/error.h"
+#include "pvr/util/json_number.h"
 
 namespace pvr {
 namespace {
@@ -216,18 +215,6 @@ struct GltfExtras {
   std::string name;
 };
 
-// nlohmann's get<T>() casts, which is undefined for a number outside T's range: check first.
-float finiteFloat(const nlohmann::json& j) {
-  const double v = j.is_number() ? j.get<double>() : std::nan("");
-  if (!(std::abs(v) <= double(std::numeric_limits<float>::max()))) throw std::out_of_range("not a finite float");
-  return float(v);
-}
-uint32_t smallUnsigned(const nlohmann::json& j) {
-  if (!j.is_number_unsigned() || j.get<uint64_t>() > std::numeric_limits<uint32_t>::max())
-    throw std::out_of_range("not a 32-bit unsigned integer");
-  return uint32_t(j.get<uint64_t>());
-}
-
 TextureTransform transformOf(const nlohmann::json& textureInfo) {
   TextureTransform out;
   if (!textureInfo.is_object() || !textureInfo.contains("extensions") ||
@@ -235,10 +222,10 @@ TextureTransform transformOf(const nlohmann::json& textureInfo) {
     return out;
   const nlohmann::json& x = textureInfo["extensions"]["KHR_texture_transform"];
   out.present = true;
-  if (x.contains("offset") && x["offset"].size() == 2) out.transform.offset = {finiteFloat(x["offset"][0]), finiteFloat(x["offset"][1])};
-  if (x.contains("scale") && x["scale"].size() == 2) out.transform.scale = {finiteFloat(x["scale"][0]), finiteFloat(x["scale"][1])};
-  if (x.contains("rotation")) out.transform.rotation = finiteFloat(x["rotation"]);
-  if (x.contains("texCoord")) out.transform.texCoord = smallUnsigned(x["texCoord"]), out.texCoordOverride = true;
+  if (x.contains("offset") && x["offset"].size() == 2) out.transform.offset = {jsonNumber<float>(x["offset"][0], "offset"), jsonNumber<float>(x["offset"][1], "offset")};
+  if (x.contains("scale") && x["scale"].size() == 2) out.transform.scale = {jsonNumber<float>(x["scale"][0], "scale"), jsonNumber<float>(x["scale"][1], "scale")};
+  if (x.contains("rotation")) out.transform.rotation = jsonNumber<float>(x["rotation"], "rotation");
+  if (x.contains("texCoord")) out.transform.texCoord = jsonNumber<uint32_t>(x["texCoord"], "texCoord"), out.texCoordOverride = true;
   return out;
 }
 
@@ -258,7 +245,7 @@ std::vector<GltfExtras> readGltfExtras(const nlohmann::json& doc) {
       if (m.contains("extensions") && m["extensions"].contains("KHR_materials_emissive_strength"))
         strength = &m["extensions"]["KHR_materials_emissive_strength"];
       if (strength && strength->contains("emissiveStrength") && (*strength)["emissiveStrength"].is_number())
-        e.emissiveStrength = finiteFloat((*strength)["emissiveStrength"]);
+        e.emissiveStrength = jsonNumber<float>((*strength)["emissiveStrength"], "emissiveStrength");
       if (m.contains("pbrMetallicRoughness") && m["pbrMetallicRoughness"].is_object()) {
         const json& pbr = m["pbrMetallicRoughness"];
         if (pbr.contains("baseColorTexture")) e.transforms[kBaseColorSlot] = transformOf(pbr["baseColorTexture"]);

@@ -5,12 +5,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
 #include "pvr/util/input_limits.h"
+#include "pvr/util/json_number.h"
 
 namespace pvr {
 namespace {
@@ -40,10 +40,7 @@ using nlohmann::json;
 
 float number(const json& j, const std::string& what) {
   if (!j.is_number()) throw Error(what + " must be a number");
-  // Checked as a double: nlohmann's get<float>() would cast, undefined past float's range.
-  const double v = j.get<double>();
-  if (!(std::abs(v) <= double(std::numeric_limits<float>::max()))) throw Error(what + " must be finite");
-  return float(v);
+  return jsonNumber<float>(j, what);
 }
 
 Vec3 vec3(const json& j, const std::string& what) {
