@@ -9,6 +9,7 @@
 #include "pvr/render/renderer.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
+#include "pvr/util/json_number.h"
 #include "test_scenes.h"
 
 namespace pvr {
@@ -127,6 +128,40 @@ TEST(SceneErrors, NumbersOutsideTheirTypesAreRejectedNotCast) {
   EXPECT_EQ(s.triangleCount(), 8u);
   const Vec3 emission = materialNamed(s, "floor").emission;  // factor 0.25, strength 1e300 dropped
   EXPECT_TRUE(std::isfinite(emission.x) && emission.x <= 0.25f) << emission.x;
+  // An accessor's componentType of 1e20 (read before assimp, to check the accessor's range): a
+  // clear one-line error, never a cast.
+  const std::string accessor =
+      errorOf([] { loadScene(kData + "/../fuzz/regressions/mesh/gltf-accessor-component-type-1e20.gltf"); });
+  EXPECT_FALSE(accessor.empty());
+  EXPECT_EQ(accessor.find('\n'), std::string::npos) << accessor;
+}
+
+// jsonNumberFits: exactly the values the type holds, whole-valued floats included for integers
+// (JSON Schema counts 3.0 as an integer), with the bounds at the type's powers of two.
+TEST(SceneErrors, JsonNumbersFitExactlyTheValuesTheirTypeHolds) {
+  using nlohmann::json;
+  EXPECT_TRUE(jsonNumberFits<int>(json(3.0)));
+  EXPECT_FALSE(jsonNumberFits<int>(json(2.5)));
+  EXPECT_TRUE(jsonNumberFits<int>(json(2147483647)));
+  EXPECT_FALSE(jsonNumberFits<int>(json(2147483648u)));
+  EXPECT_TRUE(jsonNumberFits<int>(json(-2147483648.0)));
+  EXPECT_FALSE(jsonNumberFits<int>(json(2147483648.0)));
+  EXPECT_FALSE(jsonNumberFits<uint32_t>(json(-1)));
+  EXPECT_FALSE(jsonNumberFits<uint32_t>(json(1e20)));
+  EXPECT_TRUE(jsonNumberFits<uint32_t>(json(4294967295.0)));
+  EXPECT_TRUE(jsonNumberFits<int64_t>(json(-9223372036854775808.0)));  // -2^63
+  EXPECT_FALSE(jsonNumberFits<int64_t>(json(9223372036854775808.0)));  // 2^63: double(INT64_MAX) rounds to it
+  EXPECT_TRUE(jsonNumberFits<uint64_t>(json(18446744073709551615u)));
+  EXPECT_FALSE(jsonNumberFits<uint64_t>(json(18446744073709551616.0)));
+  EXPECT_TRUE(jsonNumberFits<float>(json(-3e38)));
+  EXPECT_FALSE(jsonNumberFits<float>(json(1e39)));
+  EXPECT_TRUE(jsonNumberFits<double>(json(1e300)));
+  EXPECT_FALSE(jsonNumberFits<float>(json(std::nan(""))));
+  EXPECT_FALSE(jsonNumberFits<int>(json("3")));
+  EXPECT_FALSE(jsonNumberFits<int>(json(true)));
+  EXPECT_EQ(jsonNumber<int>(json(7.0), "k"), 7);
+  EXPECT_NE(errorOf([] { jsonNumber<int>(json(1e20), "k"); }).find("k must be an integer from -2147483648 to 2147483647"),
+            std::string::npos);
 }
 
 TEST(SceneErrors, BadRenderOptionsAreRejected) {

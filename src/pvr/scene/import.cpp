@@ -241,20 +241,26 @@ std::vector<GltfExtras> readGltfExtras(const nlohmann::json& doc) {
         continue;
       }
       if (m.contains("name") && m["name"].is_string()) e.name = m["name"].get<std::string>();
-      const json* strength = nullptr;
-      if (m.contains("extensions") && m["extensions"].contains("KHR_materials_emissive_strength"))
-        strength = &m["extensions"]["KHR_materials_emissive_strength"];
-      if (strength && strength->contains("emissiveStrength") && (*strength)["emissiveStrength"].is_number())
-        e.emissiveStrength = jsonNumber<float>((*strength)["emissiveStrength"], "emissiveStrength");
-      if (m.contains("pbrMetallicRoughness") && m["pbrMetallicRoughness"].is_object()) {
-        const json& pbr = m["pbrMetallicRoughness"];
-        if (pbr.contains("baseColorTexture")) e.transforms[kBaseColorSlot] = transformOf(pbr["baseColorTexture"]);
-        if (pbr.contains("metallicRoughnessTexture"))
-          e.transforms[kMetallicRoughnessSlot] = transformOf(pbr["metallicRoughnessTexture"]);
+      try {
+        const json* strength = nullptr;
+        if (m.contains("extensions") && m["extensions"].contains("KHR_materials_emissive_strength"))
+          strength = &m["extensions"]["KHR_materials_emissive_strength"];
+        if (strength && strength->contains("emissiveStrength") && (*strength)["emissiveStrength"].is_number())
+          e.emissiveStrength = jsonNumber<float>((*strength)["emissiveStrength"], "emissiveStrength");
+        if (m.contains("pbrMetallicRoughness") && m["pbrMetallicRoughness"].is_object()) {
+          const json& pbr = m["pbrMetallicRoughness"];
+          if (pbr.contains("baseColorTexture")) e.transforms[kBaseColorSlot] = transformOf(pbr["baseColorTexture"]);
+          if (pbr.contains("metallicRoughnessTexture"))
+            e.transforms[kMetallicRoughnessSlot] = transformOf(pbr["metallicRoughnessTexture"]);
+        }
+        if (m.contains("normalTexture")) e.transforms[kNormalSlot] = transformOf(m["normalTexture"]);
+        if (m.contains("emissiveTexture")) e.transforms[kEmissiveSlot] = transformOf(m["emissiveTexture"]);
+        if (m.contains("occlusionTexture")) e.transforms[kOcclusionSlot] = transformOf(m["occlusionTexture"]);
+      } catch (const std::exception&) {  // a value out of spec: this material's extensions are dropped, not the file's
+        GltfExtras plain;
+        plain.name = e.name;
+        e = plain;
       }
-      if (m.contains("normalTexture")) e.transforms[kNormalSlot] = transformOf(m["normalTexture"]);
-      if (m.contains("emissiveTexture")) e.transforms[kEmissiveSlot] = transformOf(m["emissiveTexture"]);
-      if (m.contains("occlusionTexture")) e.transforms[kOcclusionSlot] = transformOf(m["occlusionTexture"]);
       out.push_back(e);
     }
   } catch (const std::exception&) {
@@ -268,11 +274,16 @@ size_t gltfElementBytes(const nlohmann::json& accessor) {
   static const std::pair<int, size_t> kComponents[] = {{5120, 1}, {5121, 1}, {5122, 2}, {5123, 2}, {5125, 4}, {5126, 4}};
   static const std::pair<const char*, size_t> kTypes[] = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
                                                           {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
+  if (!accessor.is_object()) return 0;
+  const nlohmann::json& c = accessor.contains("componentType") ? accessor["componentType"] : nlohmann::json();
+  const nlohmann::json& t = accessor.contains("type") ? accessor["type"] : nlohmann::json();
+  const int componentType = jsonNumberFits<int>(c) ? c.get<int>() : 0;
+  const std::string type = t.is_string() ? t.get<std::string>() : std::string();
   size_t component = 0, count = 0;
-  for (auto [type, bytes] : kComponents)
-    if (accessor.value("componentType", 0) == type) component = bytes;
+  for (auto [code, bytes] : kComponents)
+    if (componentType == code) component = bytes;
   for (auto [name, n] : kTypes)
-    if (accessor.value("type", std::string()) == name) count = n;
+    if (type == name) count = n;
   return component * count;
 }
 

@@ -97,7 +97,7 @@ void applyCamera(const json& cam, StereoRig& rig) {
     const json& s = cam["eye_size"];
     auto pixels = [](const json& n) { return n.is_number_unsigned() && n.get<uint64_t>() <= 65536; };
     if (!s.is_array() || s.size() != 2 || !pixels(s[0]) || !pixels(s[1]))
-      throw Error("camera.eye_size must be [width, height] in pixels (at most 65536)");
+      throw Error("camera.eye_size must be [width, height] in whole pixels");
     rig.width = int(s[0].get<uint64_t>());
     rig.height = int(s[1].get<uint64_t>());
   }

@@ -1,7 +1,8 @@
 #pragma once
 // A JSON number as a C++ arithmetic type, checked before it is converted: nlohmann's get<T>()
 // casts, and a cast of a value outside T's range is undefined (the mesh fuzzer found a glTF
-// texCoord of 1e20 read as uint32_t). Every reader of a user's file takes its numbers through here.
+// texCoord of 1e20 read as uint32_t). The readers of users' JSON (glTF extensions and accessors,
+// scene files, settings files, controller profiles) take their numbers through here.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -15,17 +16,23 @@
 
 namespace pvr {
 
-// Whether `j` is a number that T holds: for an integral T an integer within its range (3.0 and
-// 1e20 are floats in JSON, not integers), for a floating-point T a finite value within its range.
+// Whether `j` is a number that T holds: for an integral T a whole number within its range (3 or
+// 3.0, as JSON Schema counts integers; not 2.5, not 1e20 for an int), for a floating-point T a
+// finite value within its range.
 template <class T>
 bool jsonNumberFits(const nlohmann::json& j) {
-  static_assert(std::is_arithmetic_v<T> && !std::is_same_v<T, bool>);
+  static_assert((std::is_integral_v<T> && !std::is_same_v<T, bool>) || std::is_same_v<T, float> || std::is_same_v<T, double>);
   if constexpr (std::is_integral_v<T>) {
     constexpr uint64_t most = uint64_t(std::numeric_limits<T>::max());
     if (j.is_number_unsigned()) return j.get<uint64_t>() <= most;
-    if (!j.is_number_integer()) return false;
-    const int64_t v = j.get<int64_t>();
-    return v < 0 ? std::is_signed_v<T> && v >= int64_t(std::numeric_limits<T>::min()) : uint64_t(v) <= most;
+    if (j.is_number_integer()) {
+      const int64_t v = j.get<int64_t>();
+      return v < 0 ? std::is_signed_v<T> && v >= int64_t(std::numeric_limits<T>::min()) : uint64_t(v) <= most;
+    }
+    if (!j.is_number_float()) return false;
+    // Bounds as powers of two, exact in a double (double(INT64_MAX) would round up past it).
+    const double v = j.get<double>(), limit = std::ldexp(1.0, std::numeric_limits<T>::digits);
+    return std::trunc(v) == v && v < limit && (std::is_signed_v<T> ? v >= -limit : v >= 0.0);
   } else {
     if (!j.is_number()) return false;
     const double v = j.get<double>();
