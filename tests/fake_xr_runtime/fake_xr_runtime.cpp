@@ -404,29 +404,59 @@ XRAPI_ATTR XrResult XRAPI_CALL destroyAction(XrAction action) {
   return g.actions.erase(uint64_t(reinterpret_cast<uintptr_t>(action))) ? XR_SUCCESS : XR_ERROR_HANDLE_INVALID;
 }
 
-// The OpenXR 1.0 core profiles are accepted (the spec requires it); only the simple controller's
-// bindings take effect, as on a runtime with those controllers in hand.
+// The OpenXR 1.0 core controller profiles, each with its button inputs (both hands unless the
+// path names one) and the poses; a binding to anything else is refused, as a runtime must.
+struct Profile {
+  const char* path;
+  std::vector<std::string> inputs;
+};
+const std::vector<Profile>& coreProfiles() {
+  static const std::vector<Profile> profiles = {
+      {"/interaction_profiles/khr/simple_controller", {"select/click", "menu/click"}},
+      {"/interaction_profiles/oculus/touch_controller",
+       {"left/x/click", "left/y/click", "left/menu/click", "right/a/click", "right/b/click", "squeeze/value", "trigger/value",
+        "thumbstick/click"}},
+      {"/interaction_profiles/valve/index_controller",
+       {"a/click", "b/click", "squeeze/value", "trigger/click", "trigger/value", "thumbstick/click", "trackpad/touch"}},
+      {"/interaction_profiles/htc/vive_controller", {"menu/click", "squeeze/click", "trigger/click", "trackpad/click"}},
+      {"/interaction_profiles/microsoft/motion_controller",
+       {"menu/click", "squeeze/click", "trigger/value", "thumbstick/click", "trackpad/click"}},
+  };
+  return profiles;
+}
+
+bool profileHas(const Profile& profile, const std::string& path) {
+  for (const char* hand : {"left", "right"}) {
+    const std::string prefix = std::string("/user/hand/") + hand + "/input/";
+    if (path.rfind(prefix, 0) != 0) continue;
+    const std::string input = path.substr(prefix.size());
+    if (input == "grip/pose" || input == "aim/pose") return true;
+    for (const std::string& i : profile.inputs)
+      if (i == input || i == hand + ("/" + input)) return true;
+  }
+  return false;
+}
+
+// Suggested bindings: the core profiles are taken (the spec requires it), each call replacing the
+// profile's earlier suggestions; only the simple controller's take effect, as on a runtime with
+// those controllers in hand.
 XRAPI_ATTR XrResult XRAPI_CALL suggestBindings(XrInstance, const XrInteractionProfileSuggestedBinding* info) {
-  const std::string profile = pathText(info->interactionProfile);
-  static const char* known[] = {"/interaction_profiles/khr/simple_controller", "/interaction_profiles/oculus/touch_controller",
-                                "/interaction_profiles/valve/index_controller", "/interaction_profiles/htc/vive_controller",
-                                "/interaction_profiles/microsoft/motion_controller"};
-  if (std::find(std::begin(known), std::end(known), profile) == std::end(known) || mode() == "nocontrollers")
-    return XR_ERROR_PATH_UNSUPPORTED;
+  const std::string name = pathText(info->interactionProfile);
+  const Profile* profile = nullptr;
+  for (const Profile& p : coreProfiles())
+    if (name == p.path) profile = &p;
+  if (!profile || mode() == "nocontrollers") return XR_ERROR_PATH_UNSUPPORTED;
   if (g.attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
-  const bool simple = profile == known[0];
   for (uint32_t i = 0; i < info->countSuggestedBindings; ++i) {
     const XrActionSuggestedBinding& b = info->suggestedBindings[i];
-    auto it = g.actions.find(uint64_t(reinterpret_cast<uintptr_t>(b.action)));
-    const std::string where = pathText(b.binding);
-    if (it == g.actions.end()) return XR_ERROR_HANDLE_INVALID;
-    if (where.rfind("/user/hand/left/input/", 0) != 0 && where.rfind("/user/hand/right/input/", 0) != 0) return XR_ERROR_PATH_UNSUPPORTED;
-    if (simple) {
-      const bool click = where.size() > 13 && where.compare(where.size() - 13, 13, "/select/click") == 0;
-      if (!click && where.find("/pose") == std::string::npos) return XR_ERROR_PATH_UNSUPPORTED;  // select, menu, poses
-      it->second.bindings.push_back(b.binding);
-    }
+    if (!g.actions.count(uint64_t(reinterpret_cast<uintptr_t>(b.action)))) return XR_ERROR_HANDLE_INVALID;
+    if (!profileHas(*profile, pathText(b.binding))) return XR_ERROR_PATH_UNSUPPORTED;
   }
+  if (profile != &coreProfiles()[0]) return XR_SUCCESS;
+  for (auto& [handle, action] : g.actions) action.bindings.clear();
+  for (uint32_t i = 0; i < info->countSuggestedBindings; ++i)
+    g.actions[uint64_t(reinterpret_cast<uintptr_t>(info->suggestedBindings[i].action))].bindings.push_back(
+        info->suggestedBindings[i].binding);
   return XR_SUCCESS;
 }
 

@@ -260,8 +260,8 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     std::printf("  %s backend (%s), hand-over %s, %s space\n", renderer.backendName().c_str(), renderer.deviceName().c_str(),
                 info.handOver.c_str(), info.space.c_str());
     if (info.controllerProfiles)
-      std::printf("  controllers: right select, A or trackpad: every material at the next effect level; left select or\n"
-                  "  trackpad, or B: the scene's own levels\n");
+      std::printf("  controllers: right select, A or trackpad: every material at the next effect level; right B,\n"
+                  "  left select or trackpad: the scene's own levels\n");
     std::optional<FoveationMask> controlMask;
     std::unique_ptr<BudgetController> controller = makeBudgetController(
         parseBudget(args.budget), args.controllerProfile, *setup.scene, renderer.options(), renderer.rig(), args.acuity, controlMask);

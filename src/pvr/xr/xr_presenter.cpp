@@ -119,7 +119,8 @@ struct XrPresenter::Impl {
   Button buttons[2];
   std::deque<Button> presses;  ///< seen at the frame's sync, applied by adjustOptions
   int controllerPresses = 0;
-  uint64_t frames = 0;
+  bool syncedFocused = false;  ///< the last frame synced the actions (focus held since)
+  uint64_t frames = 0;         ///< frames waited for (the one being prepared: frames - 1)
   PFN_xrConvertTimeToTimespecTimeKHR toTimespec = nullptr;
   // The frame in flight
   bool frameBegun = false;
@@ -490,7 +491,8 @@ void XrPresenter::adjustOptions(RenderOptions& options) {
   const Button press = m.presses.front();
   m.presses.pop_front();
   ++m.controllerPresses;
-  std::printf("xr: frame %llu: controller (%s): %s\n", (unsigned long long)m.frames, press.name, applyLoopKey(press.key, options).c_str());
+  std::printf("xr: frame %llu: controller (%s): %s\n", (unsigned long long)(m.frames - 1), press.name,
+              applyLoopKey(press.key, options).c_str());
   std::fflush(stdout);
 }
 
@@ -579,8 +581,11 @@ bool XrPresenter::waitFrame(FrameRequest& request) {
     sync.countActiveActionSets = 1;
     sync.activeActionSets = &active;
     synced = xrSyncActions(m.session, &sync);
-    if (synced == XR_SUCCESS) m.readButtons();
+    // A button already down when focus comes (back) is not a press: it went down elsewhere (a
+    // system menu, another application).
+    if (synced == XR_SUCCESS && m.syncedFocused) m.readButtons();
   }
+  m.syncedFocused = synced == XR_SUCCESS;
   if (m.gazeSpace && synced == XR_SUCCESS && m.viewsValid) {
     XrSpaceLocation location{XR_TYPE_SPACE_LOCATION};
     if (xrLocateSpace(m.gazeSpace, m.space, m.frameState.predictedDisplayTime, &location) == XR_SUCCESS &&

@@ -58,7 +58,7 @@ class XrPresenter : public Presenter {
   void requestStop() override;
   // Applies one controller press seen since the last frame (one a frame, as the keys): the
   // right hand's select, A or trackpad puts every material at the next effect level, the left
-  // hand's select or trackpad (or B) gives each material its own level again.
+  // hand's select or trackpad, or the right hand's B, gives each material its own level again.
   void adjustOptions(RenderOptions& options) override;
 
   const XrSessionInfo& info() const { return info_; }
