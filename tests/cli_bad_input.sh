@@ -168,25 +168,20 @@ expect_error "--cuda-copy must be" xr --offscreen --backend cpu --cuda-copy dma 
 expect_error "--near must be" xr --offscreen --backend cpu --near -1 --frames 1
 expect_error "--ready-timeout must be" xr --backend cpu --ready-timeout 0 --frames 1
 expect_error "cannot read settings file" render --settings "$out/none.json" "${small[@]}"
-echo '{"radius": ' >"$out/broken.json"
-expect_error "not valid JSON" render --settings "$out/broken.json" "${small[@]}"
-echo '[1, 2]' >"$out/array.json"
-expect_error "must hold a JSON object" render --settings "$out/array.json" "${small[@]}"
-echo '{"head": {"position": [0, 1], "orientation": [0, 0, 0, 1]}}' >"$out/short.json"
-expect_error "wrong type or is missing" render --settings "$out/short.json" "${small[@]}"
-echo '{"head": {"position": [0, 1, 2], "orientation": [0, 0, 0, 0]}}' >"$out/zero.json"
-expect_error "non-zero quaternion" render --settings "$out/zero.json" "${small[@]}"
-echo '{"radius": "-1"}' >"$out/radius.json"
-expect_error "radius" render --settings "$out/radius.json" "${small[@]}"
+expect_settings_error() {  # expected-substring, the settings file's text
+  printf '%s\n' "$2" >"$out/settings.json"
+  expect_error "$1" render --settings "$out/settings.json" "${small[@]}"
+}
+expect_settings_error "not valid JSON" '{"radius": '
+expect_settings_error "must hold a JSON object" '[1, 2]'
+expect_settings_error "wrong type or is missing" '{"head": {"position": [0, 1], "orientation": [0, 0, 0, 1]}}'
+expect_settings_error "non-zero quaternion" '{"head": {"position": [0, 1, 2], "orientation": [0, 0, 0, 0]}}'
+expect_settings_error "radius" '{"radius": "-1"}'
 # Numbers outside the type they fill: an error naming the key, never a cast (undefined there).
-echo '{"k": 1e20}' >"$out/k.json"
-expect_error "k must be an integer" render --settings "$out/k.json" "${small[@]}"
-echo '{"denoise_iterations": 2.5}' >"$out/iterations.json"
-expect_error "denoise_iterations must be an integer" render --settings "$out/iterations.json" "${small[@]}"
-echo '{"exposure": 1e300}' >"$out/exposure.json"
-expect_error "exposure must be a finite number" render --settings "$out/exposure.json" "${small[@]}"
-echo '{"head": {"position": [0, 1e39, 0], "orientation": [0, 0, 0, 1]}}' >"$out/far.json"
-expect_error "the head pose must be a finite number" render --settings "$out/far.json" "${small[@]}"
+expect_settings_error "k must be an integer" '{"k": 1e20}'
+expect_settings_error "denoise_iterations must be an integer" '{"denoise_iterations": 2.5}'
+expect_settings_error "exposure must be a finite number" '{"exposure": 1e300}'
+expect_settings_error "the head pose must be a finite number" '{"head": {"position": [0, 1e39, 0], "orientation": [0, 0, 0, 1]}}'
 expect_error "--acuity must be" render cornell --foveated --acuity sharp "${small[@]}"
 
 # NaN vertices and degenerate triangles: a warning, and the render goes on.
