@@ -4,6 +4,7 @@
 #include <cuda_runtime.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <utility>
@@ -866,6 +867,20 @@ TEST(GpuBackend, BlueNoiseSamplesAreTheHostsToTheBit) {
   size_t differing = 0;
   for (size_t k = 0; k < gpu.size(); ++k) differing += gpu[k] != host[k];
   EXPECT_EQ(differing, 0u) << "of " << gpu.size() << " words";
+}
+
+// The denoiser's packed levels (svgf.h) hold the same bits on both backends: every 256th float
+// (every exponent, sign and high mantissa, and every tie: a tie's low 13 bits are 0x1000).
+TEST(GpuBackend, HalfFloatsAreTheHostsToTheBit) {
+  PVR_REQUIRE_GPU();
+  const std::vector<uint16_t> gpu = halfBitsOnGpu(256), host = halfBitsOnHost(256);
+  ASSERT_EQ(gpu.size(), host.size());
+  size_t differing = 0, first = gpu.size();
+  for (size_t k = 0; k < gpu.size(); ++k)
+    if (gpu[k] != host[k] && !((host[k] & 0x7c00u) == 0x7c00u && (host[k] & 0x3ffu) && (gpu[k] & 0x7c00u) == 0x7c00u &&
+                               (gpu[k] & 0x3ffu)))  // NaNs may differ in payload
+      ++differing, first = std::min(first, k);
+  EXPECT_EQ(differing, 0u) << "of " << gpu.size() << "; first at float bits " << std::hex << first * 256;
 }
 
 }  // namespace

@@ -2,7 +2,6 @@
 // One eye's denoising state over either backend's buffers (host vectors, device buffers: anything
 // with data()), and the frame's view of it: written once for the HostDenoiser and the GpuDenoiser,
 // which only size the buffers their own way and run the passes.
-#include <algorithm>
 
 #include "pvr/denoise/svgf.h"
 #include "pvr/util/error.h"
@@ -23,12 +22,18 @@ struct DenoiseEyeState {
   bool valid = false;
   EyeCamera camera;
   Buffer<float> depthGradient;
-  Buffer<ColourVariance> levels[2][kDenoiseLevels];  ///< two (ping-pong) unless keepLevels
+  Buffer<ColourVariance> level0[2];
+  // The packed levels 1 .. iterations - 1 (the last pass's output is not kept): two buffers
+  // (ping-pong by the level's parity) unless keepLevels, where level k has buffer k.
+  Buffer<PackedColourVariance> levels[2][kDenoiseLevels];
+  Buffer<uint32_t> peak;  ///< one word: level 0's largest value (levelScale)
 
   History& next() { return history[latest ^ 1]; }
-  // Level buffers this frame needs: each level its own for a left eye that a right eye reuses.
-  static int levelBuffers(const DenoiseParams& params, const DenoiseInputs& in) {
-    return in.keepLevels ? params.iterations + 1 : 2;
+  // The buffer that holds packed level k (1 .. iterations - 1) this frame.
+  static int levelBuffer(int k, const DenoiseInputs& in) { return in.keepLevels ? k : k & 1; }
+  // Levels this frame keeps: every one for a left eye that a right eye reuses.
+  static int levelsKept(const DenoiseParams& params, const DenoiseInputs& in) {
+    return in.keepLevels ? params.iterations + 1 : 0;
   }
   // Starts a frame: a history of another size or number of signals is not read.
   void begin(const EyeCamera& c, const DenoiseInputs& in) {
@@ -39,7 +44,7 @@ struct DenoiseEyeState {
     latest ^= 1;
     camera = c;
     signals = in.direct ? 2 : 1;
-    keptLevels = in.keepLevels ? levelBuffers(params, in) : 0;
+    keptLevels = levelsKept(params, in);
     valid = true;
   }
 };
@@ -50,7 +55,7 @@ struct DenoiseEyeState {
 template <class State>
 DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const DenoiseParams& params, const DenoiseInputs& in,
                                   int stillFrames, State& state, const State& left, Vec3* out) {
-  const int signals = in.direct ? 2 : 1, levels = State::levelBuffers(params, in);
+  const int signals = in.direct ? 2 : 1;
   DenoiseFrameView v;
   v.camera = camera;
   v.in = in;
@@ -69,10 +74,10 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
   v.guide = next.guide.data();
   v.moments = next.moments.data();
   v.length = next.length.data();
-  const int lastLevel = std::max(levels - 1, 0);  // the views past the frame's levels point at its last
+  v.peak = state.peak.data();
   for (int s = 0; s < signals; ++s) {
-    for (int k = 0; k < kDenoiseLevels; ++k)
-      v.filtered[s][k] = state.levels[s][in.keepLevels ? std::min(k, lastLevel) : k & 1].data();
+    v.level0[s] = state.level0[s].data();
+    for (int k = 1; k < params.iterations; ++k) v.packed[s][k] = state.levels[s][State::levelBuffer(k, in)].data();
     v.historyOut[s] = next.colour[s].data();
   }
   v.out = out;
@@ -83,8 +88,10 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
     const auto& shared = left.history[left.latest];
     for (int s = 0; s < signals; ++s) {
       v.source.history[s] = shared.colour[s].data();
-      for (int k = 0; k <= params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
+      v.source.level0[s] = left.level0[s].data();
+      for (int k = 1; k < params.iterations; ++k) v.source.packed[s][k] = left.levels[s][k].data();
     }
+    v.source.peak = left.peak.data();
     v.source.moments = shared.moments.data();
     v.source.length = shared.length.data();
   }

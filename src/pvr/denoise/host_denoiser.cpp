@@ -1,6 +1,7 @@
 #include "pvr/denoise/host_denoiser.h"
 
 #include <atomic>
+#include <bit>
 
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
@@ -23,13 +24,15 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   if (!in.image || !in.inverseDepth) throw Error("the denoiser needs the eye's image and its per-pixel depth");
   EyeState& state = eyes_[int(eye)];
   const size_t pixels = size_t(camera.width) * camera.height;
-  const int signals = in.direct ? 2 : 1, levels = EyeState::levelBuffers(params, in);
+  const int signals = in.direct ? 2 : 1;
   state.begin(camera, in);
   EyeState::History& next = state.next();
   for (int s = 0; s < signals; ++s) {
     next.colour[s].resize(pixels);
-    for (int k = 0; k < levels; ++k) state.levels[s][k].resize(pixels);
+    state.level0[s].resize(pixels);
+    for (int k = 1; k < params.iterations; ++k) state.levels[s][EyeState::levelBuffer(k, in)].resize(pixels);
   }
+  state.peak.assign(1, 0u);
   next.moments.resize(4 * pixels);
   next.length.resize(pixels);
   next.guide.resize(pixels);
@@ -39,8 +42,19 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
       denoiseFrameView(eye, camera, params, in, stillFrames, state, eyes_[int(Eye::Left)], out.pixels.data());
 
   std::atomic<size_t> used{0};
+  // Level 0's largest value, as the GPU folds it (a float's bits: non-negative floats order as
+  // their bits do).
+  std::atomic<uint32_t> peak{0};
+  auto foldPeak = [&](float value) {
+    const uint32_t bits = std::bit_cast<uint32_t>(value);
+    uint32_t seen = peak.load(std::memory_order_relaxed);
+    while (bits > seen && !peak.compare_exchange_weak(seen, bits, std::memory_order_relaxed)) {
+    }
+  };
   forEachPixel("denoise accumulate", camera, [&](int x, int y) {
-    if (accumulateDenoisePixel(v, x, y)) used.fetch_add(1, std::memory_order_relaxed);
+    float pixelPeak = 0.0f;
+    if (accumulateDenoisePixel(v, x, y, &pixelPeak)) used.fetch_add(1, std::memory_order_relaxed);
+    foldPeak(pixelPeak);
   });
   // The later passes run over the pixels the eye filters (svgf.h's filtersPixel).
   auto forEachFiltered = [&](const char* what, const auto& body) {
@@ -51,7 +65,12 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   if (params.iterations == 0) {
     forEachFiltered("denoise remodulate", [&](int x, int y) { remodulateAccumulated(v, x, y); });
   } else {
-    forEachFiltered("denoise variance", [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
+    forEachFiltered("denoise variance", [&](int x, int y) {
+      float pixelPeak = 0.0f;
+      estimateDenoiseVariance(v, x, y, pixelPeak);
+      foldPeak(pixelPeak);
+    });
+    state.peak[0] = peak.load();
     for (int i = 0; i < params.iterations; ++i) {
       const AtrousLevels levels = atrousLevels(v, i);
       forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, levels, x, y); });
