@@ -172,6 +172,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   next.moments.reserve(4 * pixels, "denoiser moments");
   next.length.reserve(pixels, "denoiser history length");
   next.guide.reserve(pixels, "denoiser guides");
+  if (in.reusedFrom) next.reusedFrom.reserve(pixels, "denoiser history's reused pixels");
   state.depthGradient.reserve(2 * pixels, "denoiser depth gradient");
   state.out.reserve(pixels, "denoised image");
   state.filteredPixels.reserve(pixels, "denoiser pixel list");
@@ -218,7 +219,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
       else launch("denoise a-trous", atrousTileKernel<1>, blocks, block, 0, stream, v, i, levels, tilesX);
     }
   }
-  state.end(camera, params, in);
+  state.end(camera, params, in, eyes_[int(Eye::Left)]);
 }
 
 size_t GpuDenoiser::memoryBytes() const {
@@ -227,7 +228,8 @@ size_t GpuDenoiser::memoryBytes() const {
     bytes += s.depthGradient.bytes() + s.out.bytes() + s.filteredPixels.bytes() + s.peak.bytes();
     for (const auto& level : s.level0) bytes += level.bytes();
     for (const EyeState::History& h : s.history)
-      bytes += h.colour[0].bytes() + h.colour[1].bytes() + h.moments.bytes() + h.length.bytes() + h.guide.bytes();
+      bytes += h.colour[0].bytes() + h.colour[1].bytes() + h.moments.bytes() + h.length.bytes() + h.guide.bytes() +
+               h.reusedFrom.bytes();
     for (int k = 0; k < 2; ++k)
       for (const auto& level : s.levels[k]) bytes += level.bytes();
   }

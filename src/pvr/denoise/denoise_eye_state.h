@@ -15,10 +15,17 @@ struct DenoiseEyeState {
     Buffer<ColourVariance> colour[2];
     Buffer<float> moments, length;
     Buffer<DenoiseGuide> guide;
+    // A reusing right eye's: per pixel the left pixel whose history it is (svgf.h's
+    // DenoiseHistoryView::reusedFrom), from the left eye's history buffer leftHistory.
+    Buffer<uint32_t> reusedFrom;
+    bool referencesLeft = false;
+    int leftHistory = 0;
+    uint64_t leftFrames = 0;  ///< the left eye's `frames` then
   };
   History history[2];  ///< ping-pong: the last frame's, and the one being written
   int latest = 0, signals = 0;
   int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)
+  uint64_t frames = 0;  ///< frames ended
   bool valid = false;
   EyeCamera camera;
   Buffer<float> depthGradient;
@@ -39,9 +46,16 @@ struct DenoiseEyeState {
   void begin(const EyeCamera& c, const DenoiseInputs& in) {
     if (valid && (camera.width != c.width || camera.height != c.height || signals != (in.direct ? 2 : 1))) valid = false;
   }
-  // Ends the frame: its history becomes the one read next.
-  void end(const EyeCamera& c, const DenoiseParams& params, const DenoiseInputs& in) {
+  // Ends the frame: its history becomes the one read next. A reusing right eye's refers to the
+  // left eye's history of this frame (`left`, ended before it), which the left eye keeps through
+  // its next frame (it writes its other buffer).
+  void end(const EyeCamera& c, const DenoiseParams& params, const DenoiseInputs& in, const DenoiseEyeState& left) {
+    History& written = next();
+    written.referencesLeft = in.reusedFrom != nullptr;
+    written.leftHistory = left.latest;
+    written.leftFrames = left.frames;
     latest ^= 1;
+    ++frames;
     camera = c;
     signals = in.direct ? 2 : 1;
     keptLevels = levelsKept(params, in);
@@ -61,13 +75,25 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
   v.in = in;
   v.params = params;
   v.stillFrames = stillFrames;
-  if (state.valid) {
-    const auto& previous = state.history[state.latest];
+  const auto& previous = state.history[state.latest];
+  // A history that refers to the left eye's is read only while that is still there: the left eye
+  // has ended at most one frame since (it writes its other buffer) at the same size.
+  const bool leftKept = !previous.referencesLeft ||
+                        (&state != &left && left.frames - previous.leftFrames <= 1 && left.camera.width == state.camera.width &&
+                         left.camera.height == state.camera.height);
+  if (state.valid && leftKept) {
     v.history.camera = state.camera;
     for (int s = 0; s < signals; ++s) v.history.colour[s] = previous.colour[s].data();
     v.history.moments = previous.moments.data();
     v.history.length = previous.length.data();
     v.history.guide = previous.guide.data();
+    if (previous.referencesLeft) {
+      const auto& leftHistory = left.history[previous.leftHistory];
+      v.history.reusedFrom = previous.reusedFrom.data();
+      for (int s = 0; s < signals; ++s) v.history.sourceColour[s] = leftHistory.colour[s].data();
+      v.history.sourceMoments = leftHistory.moments.data();
+      v.history.sourceLength = leftHistory.length.data();
+    }
   }
   auto& next = state.next();
   v.depthGradient = state.depthGradient.data();
@@ -81,13 +107,13 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
     v.historyOut[s] = next.colour[s].data();
   }
   v.out = out;
+  if (in.reusedFrom) v.historyReusedFrom = next.reusedFrom.data();
   if (in.reusedFrom) {
     if (eye != Eye::Right || !left.valid || left.keptLevels < params.iterations + 1 || left.signals != signals ||
         !in.sourceDenoised)
       throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
     const auto& shared = left.history[left.latest];
     for (int s = 0; s < signals; ++s) {
-      v.source.history[s] = shared.colour[s].data();
       v.source.level0[s] = left.level0[s].data();
       for (int k = 1; k < params.iterations; ++k) v.source.packed[s][k] = left.levels[s][k].data();
     }

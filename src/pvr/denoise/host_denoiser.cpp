@@ -36,6 +36,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   next.moments.resize(4 * pixels);
   next.length.resize(pixels);
   next.guide.resize(pixels);
+  if (in.reusedFrom) next.reusedFrom.resize(pixels);
   state.depthGradient.resize(2 * pixels);
   out = Image(camera.width, camera.height);
   const DenoiseFrameView v =
@@ -76,7 +77,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
       forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, levels, x, y); });
     }
   }
-  state.end(camera, params, in);
+  state.end(camera, params, in, eyes_[int(Eye::Left)]);
   return used;
 }
 

@@ -124,10 +124,9 @@ struct DenoiseInputs {
 constexpr int kDenoiseLevels = kMaxDenoiseIterations + 1;
 
 // What the left eye's denoise of this frame leaves for the right eye under stereo reuse: its new
-// history and every filter level, so that a reused right pixel is denoised once, in the left eye,
-// and a right pixel beside it filters with the left eye's values there.
+// history's length and every filter level, so that a reused right pixel is denoised once, in the
+// left eye, and a right pixel beside it filters with the left eye's values there.
 struct DenoiseSharedView {
-  const ColourVariance* history[2] = {nullptr, nullptr};
   const float* moments = nullptr;
   const float* length = nullptr;
   const ColourVariance* level0[2] = {nullptr, nullptr};
@@ -143,8 +142,30 @@ struct DenoiseHistoryView {
   const float* moments = nullptr;                        ///< 4 per pixel: each signal's luminance mean and variance
   const float* length = nullptr;                         ///< frames accumulated
   const DenoiseGuide* guide = nullptr;
+  // A right eye that reused pixels last frame: their colours, moments and length are the left
+  // eye's history of that frame at the pixel reused (referred to, not copied: a reused pixel's
+  // accumulation writes one index instead of copying 52 bytes). Per pixel the left pixel
+  // (kNotReused: the eye's own), and the left eye's history.
+  const uint32_t* reusedFrom = nullptr;
+  const ColourVariance* sourceColour[2] = {nullptr, nullptr};
+  const float* sourceMoments = nullptr;
+  const float* sourceLength = nullptr;
   PVR_HOST_DEVICE bool valid() const { return guide != nullptr; }
 };
+
+// Where a history pixel's colours, moments and length are: the eye's own, or the left eye's at the
+// pixel it reused.
+struct HistoryTap {
+  const ColourVariance* colour[2];
+  const float* moments;
+  const float* length;
+  size_t at;
+};
+PVR_HOST_DEVICE inline HistoryTap historyTap(const DenoiseHistoryView& h, size_t at) {
+  const uint32_t source = h.reusedFrom ? h.reusedFrom[at] : kNotReused;
+  if (source == kNotReused) return {{h.colour[0], h.colour[1]}, h.moments, h.length, at};
+  return {{h.sourceColour[0], h.sourceColour[1]}, h.sourceMoments, h.sourceLength, size_t(source)};
+}
 
 // One frame's working buffers of one eye (all the eye's size).
 struct DenoiseFrameView {
@@ -165,6 +186,7 @@ struct DenoiseFrameView {
   // by the accumulation and the variance pass; the backend clears it before the frame.
   uint32_t* peak = nullptr;
   ColourVariance* historyOut[2] = {nullptr, nullptr};  ///< the first pass's output: the next frame's history
+  uint32_t* historyReusedFrom = nullptr;  ///< a reusing right eye: the next history's reusedFrom
   Vec3* out = nullptr;                             ///< the denoised image
   DenoiseSharedView source;                        ///< the left eye's, where in.reusedFrom is set
   PVR_HOST_DEVICE int twoSignals() const { return in.direct ? 2 : 1; }
@@ -395,10 +417,11 @@ PVR_HOST_DEVICE inline bool catmullRomHistory(const DenoiseHistoryView& h, int x
       if ((i == 0 || i == 3) && (j == 0 || j == 3)) continue;  // a corner
       const size_t at = denoisePixel(h.camera, x0 - 1 + i, y0 - 1 + j);
       same &= sameHistoryGuide(h.guide[at], expected, guide, params);
-      const Moments m = loadMoments(h.moments, at);
+      const HistoryTap t = historyTap(h, at);
+      const Moments m = loadMoments(t.moments, t.at);
       const float w = wx[i] * wy[j];
       for (int s = 0; s < S; ++s) {
-        colour[s] += h.colour[s][at].colour * w;
+        colour[s] += t.colour[s][t.at].colour * w;
         mean[s] += m.m[2 * s] * w;
       }
       total += w;
@@ -407,14 +430,17 @@ PVR_HOST_DEVICE inline bool catmullRomHistory(const DenoiseHistoryView& h, int x
   // The clamp, a signal at a time over the 2x2 nearest (read again: cached, and fewer registers
   // held through the taps above on the GPU).
   const size_t at = denoisePixel(h.camera, x0, y0);
+  HistoryTap t[4];
   Moments m[4];
-  for (int k = 0; k < 4; ++k) m[k] = loadMoments(h.moments, at + size_t(k & 1) + size_t(k >> 1) * size_t(h.camera.width));
+  for (int k = 0; k < 4; ++k) {
+    t[k] = historyTap(h, at + size_t(k & 1) + size_t(k >> 1) * size_t(h.camera.width));
+    m[k] = loadMoments(t[k].moments, t[k].at);
+  }
   for (int s = 0; s < S; ++s) {
-    Vec3 lowest = h.colour[s][at].colour, highest = lowest;
+    Vec3 lowest = t[0].colour[s][t[0].at].colour, highest = lowest;
     float lowestMean = m[0].m[2 * s], highestMean = lowestMean;
     for (int k = 1; k < 4; ++k) {
-      const size_t q = at + size_t(k & 1) + size_t(k >> 1) * size_t(h.camera.width);
-      const Vec3 c = h.colour[s][q].colour;
+      const Vec3 c = t[k].colour[s][t[k].at].colour;
       lowest = min(lowest, c), highest = max(highest, c);
       lowestMean = fminf(lowestMean, m[k].m[2 * s]), highestMean = fmaxf(highestMean, m[k].m[2 * s]);
     }
@@ -424,24 +450,23 @@ PVR_HOST_DEVICE inline bool catmullRomHistory(const DenoiseHistoryView& h, int x
   return true;
 }
 
-// Step 2 for a pixel the eye does not filter. A reused right pixel takes the left eye's new
-// history at the pixel it reused (so it carries that history on if it is shaded by its own eye
-// next frame) and shows the left eye's denoised colour there: one denoise of that surface, and
-// both eyes agree on it. Background shows the rendered image and keeps no history (only its
-// guide, which no surface's reprojection or neighbourhood accepts).
+// Step 2 for a pixel the eye does not filter. A reused right pixel's history is the left eye's
+// new history at the pixel it reused (referred to by historyReusedFrom: it carries that history
+// on if it is shaded by its own eye next frame), and it shows the left eye's denoised colour
+// there: one denoise of that surface, and both eyes agree on it. Background shows the rendered
+// image and keeps no history (only its guide, which no surface's reprojection or neighbourhood
+// accepts).
 template <int S>
 PVR_HOST_DEVICE inline bool accumulateUnfilteredPixel(const DenoiseFrameView& v, size_t pixel) {
   const uint32_t source = reusedSourcePixel(v, pixel);
   DenoiseGuide guide;
   guide.inverseDepth = v.in.inverseDepth[pixel];
+  if (v.historyReusedFrom) v.historyReusedFrom[pixel] = source;
   if (source != kNotReused) {
     guide.normal = v.in.sourceNormal ? v.in.sourceNormal[source] : Vec3(0.0f);
     v.guide[pixel] = guide;
-    storeMoments(v.moments, pixel, loadMoments(v.source.moments, source));
-    v.length[pixel] = v.source.length[source];
-    for (int s = 0; s < S; ++s) v.historyOut[s][pixel] = v.source.history[s][source];
     v.out[pixel] = v.in.sourceDenoised[source];
-    return v.length[pixel] > 1.5f;
+    return v.source.length[source] > 1.5f;
   }
   // Background: its guide turns away every later read of its history (no surface meets it).
   v.guide[pixel] = guide;
@@ -460,6 +485,7 @@ template <int S>
 PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, int x, int y, float* peak) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   if (!filtersPixel(v, pixel)) return accumulateUnfilteredPixel<S>(v, pixel);
+  if (v.historyReusedFrom) v.historyReusedFrom[pixel] = kNotReused;
   Vec3 signal[2], albedo;
   DenoiseGuide guide;
   demodulatedInputs(v, pixel, signal, albedo, guide);
@@ -504,14 +530,15 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
           const size_t at = denoisePixel(h.camera, hx < 0 ? 0 : hx >= h.camera.width ? h.camera.width - 1 : hx,
                                          hy < 0 ? 0 : hy >= h.camera.height ? h.camera.height - 1 : hy);
           const DenoiseGuide g = h.guide[at];
+          const HistoryTap t = historyTap(h, at);
           Vec3 colours[2];
-          for (int s = 0; s < S; ++s) colours[s] = h.colour[s][at].colour;
+          for (int s = 0; s < S; ++s) colours[s] = t.colour[s][t.at].colour;
           const float w = (i ? tx : 1.0f - tx) * (j ? ty : 1.0f - ty);
           if (!(w > 0.0f) || !inside || !sameHistoryGuide(g, expected, guide, v.params)) continue;
           for (int s = 0; s < S; ++s) history[s] += colours[s] * w;
-          const Moments m = loadMoments(h.moments, at);
+          const Moments m = loadMoments(t.moments, t.at);
           for (int k = 0; k < 4; ++k) historyMoments[k] += m.m[k] * w;
-          historyLength += h.length[at] * w;
+          historyLength += t.length[t.at] * w;
           total += w;
         }
       // A moving head resamples the history every frame: bilinear weights blur it by an amount
@@ -587,7 +614,9 @@ PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v,
   // The window's luminance mean and mean square (each pixel's variance plus its squared mean).
   float sum[4], total = 1.0f;
   auto add = [&](size_t q, float w) {
-    const Moments m = loadMoments(v.moments, q);
+    // A reused right pixel's moments are the left eye's (this frame's, at the pixel reused).
+    const uint32_t source = reusedSourcePixel(v, q);
+    const Moments m = source == kNotReused ? loadMoments(v.moments, q) : loadMoments(v.source.moments, source);
     for (int s = 0; s < 2; ++s) {
       const float mean = m.m[2 * s];
       sum[2 * s] += mean * w;
