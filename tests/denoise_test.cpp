@@ -407,6 +407,33 @@ TEST(Denoise, ReusedPixelsShareTheLeftEyesFilterAndHistory) {
   EXPECT_THROW(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right), Error);
 }
 
+// The same where reused pixels are far brighter than those the right eye shades itself: its own
+// pixels average the left eye's bright levels (here at the a-trous passes' longer steps, beyond a
+// dim reused strip that keeps them out of its own pixels' variance windows), so its packed levels
+// take a scale that covers the left eye's values too (one from its own pixels alone clamped them
+// at half's range).
+TEST(Denoise, ReusedPixelsFarBrighterThanTheRightEyesOwnKeepTheirValue) {
+  const int w = 64, h = 48;
+  HostDenoiser denoiser;
+  Image left, right;
+  SyntheticFrame f = noisyPlane(w, h, 23);
+  std::vector<uint32_t> reusedFrom(size_t(w) * h, kNotReused);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w / 2; ++x) {
+      reusedFrom[f.at(x, y)] = uint32_t(f.at(x, y));
+      if (x < w / 2 - 8) f.image[f.at(x, y)] *= 1e4f, f.direct[f.at(x, y)] *= 1e4f;
+    }
+  DenoiseInputs leftIn = f.inputs();
+  leftIn.keepLevels = true;
+  denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), leftIn, left);
+  DenoiseInputs rightIn = f.inputs();
+  rightIn.reusedFrom = reusedFrom.data();
+  rightIn.sourceNormal = f.normal.data();
+  rightIn.sourceDenoised = left.pixels.data();
+  denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right);
+  for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
+}
+
 // Background (nothing hit) is not filtered: it shows what the eye pass rendered, to the bit, and
 // what it holds never reaches a surface beside it.
 TEST(Denoise, BackgroundShowsTheRenderedImage) {

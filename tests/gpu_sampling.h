@@ -16,8 +16,8 @@ struct SamplerInput {
 std::vector<uint32_t> drawSamplesOnGpu(const std::vector<SamplerInput>& inputs);
 std::vector<uint32_t> drawSamplesOnHost(const std::vector<SamplerInput>& inputs);
 
-// util/half_float.h's halfBits of the floats whose bits are k * stride, on the GPU and the host.
-std::vector<uint16_t> halfBitsOnGpu(uint32_t stride);
-std::vector<uint16_t> halfBitsOnHost(uint32_t stride);
+// util/half_float.h's halfBits of the floats whose bits are k * stride + offset, on the GPU and the host.
+std::vector<uint16_t> halfBitsOnGpu(uint32_t stride, uint32_t offset);
+std::vector<uint16_t> halfBitsOnHost(uint32_t stride, uint32_t offset);
 
 }  // namespace pvr

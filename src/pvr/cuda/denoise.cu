@@ -186,7 +186,10 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   unsigned* count = filteredCount_.data() + e;
   // The list's length stays on the device: its passes loop over whatever it holds.
   PVR_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(unsigned), stream));
-  PVR_CUDA_CHECK(cudaMemsetAsync(v.peak, 0, sizeof(uint32_t), stream));
+  if (v.source.peak)
+    PVR_CUDA_CHECK(cudaMemcpyAsync(v.peak, v.source.peak, sizeof(uint32_t), cudaMemcpyDeviceToDevice, stream));
+  else
+    PVR_CUDA_CHECK(cudaMemsetAsync(v.peak, 0, sizeof(uint32_t), stream));
   launch("denoise accumulate", accumulateKernel, grid, block, 0, stream, v, list, count);
   if (params.iterations == 0) {
     launch("denoise remodulate", remodulateKernel, residentBlocks(remodulateKernel, pixels), kListThreads, 0, stream, v,

@@ -44,8 +44,8 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
 
   std::atomic<size_t> used{0};
   // Level 0's largest value, as the GPU folds it (a float's bits: non-negative floats order as
-  // their bits do).
-  std::atomic<uint32_t> peak{0};
+  // their bits do). A reusing right eye starts from the left eye's (svgf.h's DenoiseFrameView::peak).
+  std::atomic<uint32_t> peak{v.source.peak ? *v.source.peak : 0u};
   auto foldPeak = [&](float value) {
     const uint32_t bits = std::bit_cast<uint32_t>(value);
     uint32_t seen = peak.load(std::memory_order_relaxed);

@@ -61,7 +61,8 @@ struct alignas(8) PackedColourVariance {
 // (`peakBits`: that float's bits; a colour channel or a standard deviation): it brings that value
 // just under 2^15, half's range ending at 65504, so scenes in physical units (a sun of 1e5) fit as
 // well as dim ones. The a-trous passes average, so no later level exceeds level 0's largest
-// value. A power of two scales exactly, so both backends store the same bits.
+// value (a reusing right eye's filter also averages the left eye's levels: its largest value
+// starts from the left eye's). A power of two scales exactly, so both backends store the same bits.
 struct LevelScale {
   float scale = 1.0f, inverse = 1.0f;
 };
@@ -183,7 +184,9 @@ struct DenoiseFrameView {
   ColourVariance* level0[2] = {nullptr, nullptr};
   PackedColourVariance* packed[2][kDenoiseLevels] = {};
   // Level 0's largest value over the pixels the eye filters (a float's bits; levelScale), folded in
-  // by the accumulation and the variance pass; the backend clears it before the frame.
+  // by the accumulation and the variance pass. The backend clears it before the frame; a reusing
+  // right eye starts from the left eye's instead, since its own pixels' filter also averages the
+  // left eye's levels (its levels must hold those values too).
   uint32_t* peak = nullptr;
   ColourVariance* historyOut[2] = {nullptr, nullptr};  ///< the first pass's output: the next frame's history
   uint32_t* historyReusedFrom = nullptr;  ///< a reusing right eye: the next history's reusedFrom
