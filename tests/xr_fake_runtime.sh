@@ -57,6 +57,24 @@ else
   echo "ok   (controller buttons: held over two frames counts once; raster, shadows, the scene's own levels)"
 fi
 
+# Focus lost (frames 4-8: a system menu) while a button is pressed and held (frames 5-9): that is no
+# press, whether the runtime answers the sync with XR_SESSION_NOT_FOCUSED or the presenter skips it
+# unfocused, or the button is already down when focus comes back. Presses before and after count.
+held=""
+for f in 5 6 7 8 9; do held="$held,$f:$right"; done
+PVR_FAKE_XR=unfocus PVR_FAKE_XR_PRESS="2:$right$held,12:$right" timeout 120 "$exe" xr "${small[@]}" --frames 14 \
+  --stats "$out/unfocus.json" >"$out/unfocus.log" 2>"$out/unfocus.err"
+rc=$?
+presses=$(grep -o "controller (.*" "$out/unfocus.log" | tr '\n' '|')
+if [ $rc -ne 0 ] || [ -s "$out/unfocus.err" ] ||
+   [ "$presses" != "controller (next level): every material at raster|controller (next level): every material at shadows|" ] ||
+   ! tr -d ' \n' <"$out/unfocus.json" | grep -q '"controller_presses":2,'; then
+  echo "FAIL (unfocus): exit $rc, presses '$presses', stderr: $(cat "$out/unfocus.err")"
+  failures=$((failures + 1))
+else
+  echo "ok   (unfocus: a button held while focus was away is no press)"
+fi
+
 # A runtime that takes no controller binding: one warning line, and the session runs on.
 PVR_FAKE_XR=nocontrollers timeout 120 "$exe" xr "${small[@]}" --frames 4 --stats "$out/none.json" >"$out/none.log" 2>"$out/none.err"
 rc=$?

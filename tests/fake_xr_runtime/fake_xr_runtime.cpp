@@ -4,7 +4,9 @@
 //   ok (default) | noext (no XR_KHR_vulkan_enable2) | nohmd (no headset) | binding (the graphics
 //   binding is refused) | formats (no usable swapchain format) | noready (READY never comes) |
 //   lost (LOSS_PENDING after 5 frames) | norelease (swapchain images are never released) |
-//   nocontrollers (no controller profile's bindings are taken)
+//   nocontrollers (no controller profile's bindings are taken) | unfocus (the session loses focus,
+//   VISIBLE, at frame 4 and has it back at frame 8; xrSyncActions answers XR_SESSION_NOT_FOCUSED
+//   in between)
 // Input: actions with a khr/simple_controller in each hand. PVR_FAKE_XR_PRESS holds the buttons
 // down, "FRAME:PATH,..." (e.g. "3:/user/hand/right/input/select/click"): that input path is down
 // for the frame FRAME (counted by xrWaitFrame from 1); a path on successive frames is held.
@@ -77,6 +79,7 @@ struct State {
   uint64_t nextHandle = 16;
   int frames = 0;
   bool lossSent = false;
+  bool unfocused = false;
 } g;
 
 XrTime nowNs() {
@@ -319,6 +322,10 @@ XRAPI_ATTR XrResult XRAPI_CALL waitFrame(XrSession, const XrFrameWaitInfo*, XrFr
   state->predictedDisplayPeriod = 11'111'111;
   state->predictedDisplayTime = nowNs() + 2 * state->predictedDisplayPeriod;
   state->shouldRender = XR_TRUE;
+  if (mode() == "unfocus" && (g.waitedFrames == 4 || g.waitedFrames == 8)) {
+    g.unfocused = g.waitedFrames == 4;
+    g.events.push_back(g.unfocused ? XR_SESSION_STATE_VISIBLE : XR_SESSION_STATE_FOCUSED);
+  }
   if (mode() == "lost" && ++g.frames == 5) {
     g.events.push_back(XR_SESSION_STATE_LOSS_PENDING);
     g.lossSent = true;
@@ -492,6 +499,7 @@ XRAPI_ATTR XrResult XRAPI_CALL syncActions(XrSession, const XrActionsSyncInfo* i
     if (it == g.actionSets.end()) return XR_ERROR_HANDLE_INVALID;
     if (!it->second) return XR_ERROR_ACTIONSET_NOT_ATTACHED;
   }
+  if (g.unfocused) return XR_SESSION_NOT_FOCUSED;  // a success code: the states stay as they were
   for (auto& [handle, action] : g.actions) {
     if (action.type != XR_ACTION_TYPE_BOOLEAN_INPUT) continue;
     bool down = false;
