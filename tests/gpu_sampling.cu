@@ -1,9 +1,6 @@
 #include "gpu_sampling.h"
 
-#include <cstring>
-
 #include "pvr/cuda/cuda_util.cuh"
-#include "pvr/util/half_float.h"
 #include "pvr/util/rng.h"
 
 namespace pvr {
@@ -24,36 +21,7 @@ __global__ void drawSamplesKernel(const SamplerInput* inputs, size_t n, uint32_t
   if (i < n) drawSamples(inputs[i], out + i * kWords);
 }
 
-__global__ void halfBitsKernel(uint32_t stride, uint32_t offset, size_t n, uint16_t* out) {
-  const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < n) out[i] = halfBits(__uint_as_float(uint32_t(i) * stride + offset));
-}
-
-size_t halfInputs(uint32_t stride) { return size_t((uint64_t(1) << 32) / stride); }
-
 }  // namespace
-
-std::vector<uint16_t> halfBitsOnGpu(uint32_t stride, uint32_t offset) {
-  const size_t n = halfInputs(stride);
-  cuda::DeviceBuffer<uint16_t> out;
-  out.reserve(n, "half outputs");
-  cuda::launch("half test", halfBitsKernel, cuda::blocksFor(n, 256), 256, 0, nullptr, stride, offset, n,
-               out.data());
-  std::vector<uint16_t> result(n);
-  out.download(result.data(), n);
-  return result;
-}
-
-std::vector<uint16_t> halfBitsOnHost(uint32_t stride, uint32_t offset) {
-  std::vector<uint16_t> result(halfInputs(stride));
-  for (size_t i = 0; i < result.size(); ++i) {
-    const uint32_t bits = uint32_t(i) * stride + offset;
-    float f;
-    std::memcpy(&f, &bits, sizeof f);
-    result[i] = halfBits(f);
-  }
-  return result;
-}
 
 std::vector<uint32_t> drawSamplesOnGpu(const std::vector<SamplerInput>& inputs) {
   cuda::DeviceBuffer<SamplerInput> in;

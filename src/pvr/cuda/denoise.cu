@@ -1,8 +1,5 @@
 #include "pvr/cuda/denoise.cuh"
 
-#include <cub/block/block_reduce.cuh>
-#include <cuda/functional>
-
 #include <algorithm>
 #include <map>
 #include <mutex>
@@ -22,25 +19,13 @@ __device__ inline bool blockPixel(const EyeCamera& c, int& x, int& y) {
   return x < c.width && y < c.height;
 }
 
-// Folds a block's largest level-0 value into the eye's peak word (svgf.h's levelScale): one atomic
-// a block. Non-negative floats order as their bits do.
-template <int BlockX, int BlockY = 1>
-__device__ inline void foldPeakInBlock(uint32_t* peak, float value) {
-  using Reduce = cub::BlockReduce<uint32_t, BlockX, cub::BLOCK_REDUCE_WARP_REDUCTIONS, BlockY>;
-  __shared__ typename Reduce::TempStorage storage;
-  const uint32_t largest = Reduce(storage).Reduce(__float_as_uint(value), ::cuda::maximum<>{});
-  if (threadIdx.x == 0 && threadIdx.y == 0 && largest) atomicMax(peak, largest);
-}
-
 __global__ void __launch_bounds__(kBlock * kBlock) accumulateKernel(DenoiseFrameView v, uint32_t* filtered,
                                                                      unsigned* filteredCount) {
   int x, y;
   const bool inside = blockPixel(v.camera, x, y);
   const size_t pixel = inside ? denoisePixel(v.camera, x, y) : 0;
-  float peak = 0.0f;
-  if (inside) accumulateDenoisePixel(v, x, y, &peak);
+  if (inside) accumulateDenoisePixel(v, x, y);
   appendInBlock<kBlock * kBlock>(filtered, filteredCount, inside && filtersPixel(v, pixel), uint32_t(pixel));
-  foldPeakInBlock<kBlock, kBlock>(v.peak, peak);
 }
 
 // The later passes: a grid-stride loop over the listed pixels.
@@ -53,22 +38,14 @@ __device__ inline void forEachListed(const DenoiseFrameView& v, const uint32_t* 
   }
 }
 
-__global__ void __launch_bounds__(kListThreads) varianceKernel(DenoiseFrameView v, const uint32_t* pixels,
-                                                                const unsigned* count) {
-  float peak = 0.0f;
-  forEachListed(v, pixels, count, [&](int x, int y) { estimateDenoiseVariance(v, x, y, peak); });
-  foldPeakInBlock<kListThreads>(v.peak, peak);
+__global__ void varianceKernel(DenoiseFrameView v, const uint32_t* pixels, const unsigned* count) {
+  forEachListed(v, pixels, count, [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
 }
 
-// At most 64 registers: four blocks of 256 threads per SM (at 75 it held three). The first pass
-// reads level 0, the later ones (Packed) a half-precision level.
-template <bool Packed>
+// At most 64 registers: four blocks of 256 threads per SM (at 75 it held three).
 __global__ void __launch_bounds__(kListThreads, 4)
     atrousKernel(DenoiseFrameView v, int iteration, AtrousLevels levels, const uint32_t* pixels, const unsigned* count) {
-  forEachListed(v, pixels, count, [&](int x, int y) {
-    if constexpr (Packed) atrousDenoisePixelWith(v, iteration, levels, PackedMemoryTaps(v, levels), x, y);
-    else atrousDenoisePixelWith(v, iteration, levels, MemoryTaps{v, levels}, x, y);
-  });
+  forEachListed(v, pixels, count, [&](int x, int y) { atrousDenoisePixel(v, iteration, levels, x, y); });
 }
 
 // A full-resolution eye's a-trous pass by tiles. At step s the image splits into s x s lattices of
@@ -165,10 +142,8 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   };
   for (int s = 0; s < signals; ++s) {
     next.colour[s].reserve(pixels, "denoiser history");
-    reserveCleared(state.level0[s]);
-    for (int k = 1; k < params.iterations; ++k) reserveCleared(state.levels[s][EyeState::levelBuffer(k, in)]);
+    for (int k = 0; k < std::max(params.iterations, 1); ++k) reserveCleared(state.levels[s][EyeState::levelBuffer(k, in)]);
   }
-  state.peak.reserve(1, "denoiser level scale");
   next.moments.reserve(4 * pixels, "denoiser moments");
   next.length.reserve(pixels, "denoiser history length");
   next.guide.reserve(pixels, "denoiser guides");
@@ -186,10 +161,6 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   unsigned* count = filteredCount_.data() + e;
   // The list's length stays on the device: its passes loop over whatever it holds.
   PVR_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(unsigned), stream));
-  if (v.source.peak)
-    PVR_CUDA_CHECK(cudaMemcpyAsync(v.peak, v.source.peak, sizeof(uint32_t), cudaMemcpyDeviceToDevice, stream));
-  else
-    PVR_CUDA_CHECK(cudaMemsetAsync(v.peak, 0, sizeof(uint32_t), stream));
   launch("denoise accumulate", accumulateKernel, grid, block, 0, stream, v, list, count);
   if (params.iterations == 0) {
     launch("denoise remodulate", remodulateKernel, residentBlocks(remodulateKernel, pixels), kListThreads, 0, stream, v,
@@ -203,16 +174,11 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
     // and a foveated eye (taps at each sample's spacing) and a reusing right eye (a few pixels)
     // run over the list.
     const bool tiles = !in.sampleSpacing && !in.reusedFrom;
+    const unsigned atrousBlocks = residentBlocks(atrousKernel, pixels);
     for (int i = 0; i < params.iterations; ++i) {
       const AtrousLevels levels = atrousLevels(v, i);
-      if (i > 0) {
-        launch("denoise a-trous", atrousKernel<true>, residentBlocks(atrousKernel<true>, pixels), kListThreads, 0,
-               stream, v, i, levels, list, count);
-        continue;
-      }
-      if (!tiles) {
-        launch("denoise a-trous", atrousKernel<false>, residentBlocks(atrousKernel<false>, pixels), kListThreads, 0,
-               stream, v, i, levels, list, count);
+      if (!tiles || i > 0) {
+        launch("denoise a-trous", atrousKernel, atrousBlocks, kListThreads, 0, stream, v, i, levels, list, count);
         continue;
       }
       const int step = 1 << i, tilesX = (camera.width + step * kTile - 1) / (step * kTile);
@@ -228,8 +194,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
 size_t GpuDenoiser::memoryBytes() const {
   size_t bytes = filteredCount_.bytes();
   for (const EyeState& s : eyes_) {
-    bytes += s.depthGradient.bytes() + s.out.bytes() + s.filteredPixels.bytes() + s.peak.bytes();
-    for (const auto& level : s.level0) bytes += level.bytes();
+    bytes += s.depthGradient.bytes() + s.out.bytes() + s.filteredPixels.bytes();
     for (const EyeState::History& h : s.history)
       bytes += h.colour[0].bytes() + h.colour[1].bytes() + h.moments.bytes() + h.length.bytes() + h.guide.bytes() +
                h.reusedFrom.bytes();

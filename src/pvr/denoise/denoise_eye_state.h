@@ -3,6 +3,8 @@
 // with data()), and the frame's view of it: written once for the HostDenoiser and the GpuDenoiser,
 // which only size the buffers their own way and run the passes.
 
+#include <algorithm>
+
 #include "pvr/denoise/svgf.h"
 #include "pvr/util/error.h"
 
@@ -29,14 +31,12 @@ struct DenoiseEyeState {
   bool valid = false;
   EyeCamera camera;
   Buffer<float> depthGradient;
-  Buffer<ColourVariance> level0[2];
-  // The packed levels 1 .. iterations - 1 (the last pass's output is not kept): two buffers
-  // (ping-pong by the level's parity) unless keepLevels, where level k has buffer k.
-  Buffer<PackedColourVariance> levels[2][kDenoiseLevels];
-  Buffer<uint32_t> peak;  ///< one word: level 0's largest value (levelScale)
+  // Levels 0 .. iterations - 1 (the last pass's output is not kept): two buffers (ping-pong by
+  // the level's parity) unless keepLevels, where level k has buffer k.
+  Buffer<ColourVariance> levels[2][kDenoiseLevels];
 
   History& next() { return history[latest ^ 1]; }
-  // The buffer that holds packed level k (1 .. iterations - 1) this frame.
+  // The buffer that holds level k (0 .. iterations - 1) this frame.
   static int levelBuffer(int k, const DenoiseInputs& in) { return in.keepLevels ? k : k & 1; }
   // Levels this frame keeps: every one for a left eye that a right eye reuses.
   static int levelsKept(const DenoiseParams& params, const DenoiseInputs& in) {
@@ -100,10 +100,8 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
   v.guide = next.guide.data();
   v.moments = next.moments.data();
   v.length = next.length.data();
-  v.peak = state.peak.data();
   for (int s = 0; s < signals; ++s) {
-    v.level0[s] = state.level0[s].data();
-    for (int k = 1; k < params.iterations; ++k) v.packed[s][k] = state.levels[s][State::levelBuffer(k, in)].data();
+    for (int k = 0; k < std::max(params.iterations, 1); ++k) v.levels[s][k] = state.levels[s][State::levelBuffer(k, in)].data();
     v.historyOut[s] = next.colour[s].data();
   }
   v.out = out;
@@ -114,10 +112,8 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
       throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
     const auto& shared = left.history[left.latest];
     for (int s = 0; s < signals; ++s) {
-      v.source.level0[s] = left.level0[s].data();
-      for (int k = 1; k < params.iterations; ++k) v.source.packed[s][k] = left.levels[s][k].data();
+      for (int k = 0; k < params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
     }
-    v.source.peak = left.peak.data();
     v.source.moments = shared.moments.data();
     v.source.length = shared.length.data();
   }

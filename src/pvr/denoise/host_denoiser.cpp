@@ -1,7 +1,7 @@
 #include "pvr/denoise/host_denoiser.h"
 
+#include <algorithm>
 #include <atomic>
-#include <bit>
 
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
@@ -29,10 +29,8 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   EyeState::History& next = state.next();
   for (int s = 0; s < signals; ++s) {
     next.colour[s].resize(pixels);
-    state.level0[s].resize(pixels);
-    for (int k = 1; k < params.iterations; ++k) state.levels[s][EyeState::levelBuffer(k, in)].resize(pixels);
+    for (int k = 0; k < std::max(params.iterations, 1); ++k) state.levels[s][EyeState::levelBuffer(k, in)].resize(pixels);
   }
-  state.peak.assign(1, 0u);
   next.moments.resize(4 * pixels);
   next.length.resize(pixels);
   next.guide.resize(pixels);
@@ -43,19 +41,8 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
       denoiseFrameView(eye, camera, params, in, stillFrames, state, eyes_[int(Eye::Left)], out.pixels.data());
 
   std::atomic<size_t> used{0};
-  // Level 0's largest value, as the GPU folds it (a float's bits: non-negative floats order as
-  // their bits do). A reusing right eye starts from the left eye's (svgf.h's DenoiseFrameView::peak).
-  std::atomic<uint32_t> peak{v.source.peak ? *v.source.peak : 0u};
-  auto foldPeak = [&](float value) {
-    const uint32_t bits = std::bit_cast<uint32_t>(value);
-    uint32_t seen = peak.load(std::memory_order_relaxed);
-    while (bits > seen && !peak.compare_exchange_weak(seen, bits, std::memory_order_relaxed)) {
-    }
-  };
   forEachPixel("denoise accumulate", camera, [&](int x, int y) {
-    float pixelPeak = 0.0f;
-    if (accumulateDenoisePixel(v, x, y, &pixelPeak)) used.fetch_add(1, std::memory_order_relaxed);
-    foldPeak(pixelPeak);
+    if (accumulateDenoisePixel(v, x, y)) used.fetch_add(1, std::memory_order_relaxed);
   });
   // The later passes run over the pixels the eye filters (svgf.h's filtersPixel).
   auto forEachFiltered = [&](const char* what, const auto& body) {
@@ -66,12 +53,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   if (params.iterations == 0) {
     forEachFiltered("denoise remodulate", [&](int x, int y) { remodulateAccumulated(v, x, y); });
   } else {
-    forEachFiltered("denoise variance", [&](int x, int y) {
-      float pixelPeak = 0.0f;
-      estimateDenoiseVariance(v, x, y, pixelPeak);
-      foldPeak(pixelPeak);
-    });
-    state.peak[0] = peak.load();
+    forEachFiltered("denoise variance", [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
     for (int i = 0; i < params.iterations; ++i) {
       const AtrousLevels levels = atrousLevels(v, i);
       forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, levels, x, y); });

@@ -28,7 +28,6 @@
 #include "pvr/denoise/denoise_options.h"
 #include "pvr/stereo/stereo_reuse.h"
 #include "pvr/temporal/taa.h"
-#include "pvr/util/half_float.h"
 
 namespace pvr {
 
@@ -46,53 +45,6 @@ struct alignas(16) ColourVariance {
   Vec3 colour{0, 0, 0};
   float variance = 0.0f;
 };
-
-// A filter level past the first (levels 1 and up) in half precision: the colour and the standard
-// deviation of its luminance, times the eye's level scale (levelScale). 8 bytes instead of 16:
-// the later a-trous passes move mostly their levels through memory, and a level's rounding
-// (under 0.05 %) is far below the noise it filters. Level 0 (the accumulation) and the history
-// stay in single precision: a still head's history averages thousands of frames.
-struct alignas(8) PackedColourVariance {
-  uint16_t colour[3] = {0, 0, 0};
-  uint16_t deviation = 0;
-};
-
-// The power of two the eye's packed levels are stored at, from the largest value of its level 0
-// (`peakBits`: that float's bits; a colour channel or a standard deviation): it brings that value
-// just under 2^15, half's range ending at 65504, so scenes in physical units (a sun of 1e5) fit as
-// well as dim ones. The a-trous passes average, so no later level exceeds level 0's largest
-// value (a reusing right eye's filter also averages the left eye's levels: its largest value
-// starts from the left eye's). A power of two scales exactly, so both backends store the same bits.
-struct LevelScale {
-  float scale = 1.0f, inverse = 1.0f;
-};
-PVR_HOST_DEVICE inline LevelScale levelScale(uint32_t peakBits) {
-  const int biased = int(peakBits >> 23);  // a peak is never negative: no sign bit
-  if (peakBits == 0 || biased >= 255) return {};  // nothing filtered, or not finite (a guard)
-  const int floorLog2 = (biased > 1 ? biased : 1) - 127;  // subnormal peaks as 2^-126
-  int exponent = 14 - floorLog2;  // peak x 2^exponent < 2^15
-  exponent = exponent < -126 ? -126 : exponent > 126 ? 126 : exponent;
-  return {ldexpf(1.0f, exponent), ldexpf(1.0f, -exponent)};
-}
-// A level pixel's largest value (as levelScale counts it).
-PVR_HOST_DEVICE inline float levelPeak(const ColourVariance& c) {
-  return fmaxf(fmaxf(c.colour.x, c.colour.y), fmaxf(c.colour.z, sqrtf(c.variance)));
-}
-PVR_HOST_DEVICE inline PackedColourVariance packLevel(const ColourVariance& c, const LevelScale& s) {
-  // fminf also maps a NaN to the range's end (never expected; a guard).
-  auto half = [&](float value) { return halfBits(fminf(value * s.scale, kHalfMax)); };
-  PackedColourVariance p;
-  p.colour[0] = half(c.colour.x), p.colour[1] = half(c.colour.y), p.colour[2] = half(c.colour.z);
-  p.deviation = half(sqrtf(c.variance));
-  return p;
-}
-PVR_HOST_DEVICE inline ColourVariance unpackLevel(const PackedColourVariance& p, const LevelScale& s) {
-  ColourVariance c;
-  c.colour = Vec3(halfValue(p.colour[0]), halfValue(p.colour[1]), halfValue(p.colour[2])) * s.inverse;
-  const float deviation = halfValue(p.deviation) * s.inverse;
-  c.variance = deviation * deviation;
-  return c;
-}
 
 // What the filter compares between two pixels: the surface's normal (zero: none known) and
 // 1 / view depth (0: nothing hit).
@@ -121,7 +73,7 @@ struct DenoiseInputs {
 };
 
 // The filter's levels per signal: level 0 is the accumulated signal with its variance, level k + 1
-// the output of a-trous pass k (packed; the last pass's output is only remodulated, not kept).
+// the output of a-trous pass k (the last pass's output is only remodulated, not kept).
 constexpr int kDenoiseLevels = kMaxDenoiseIterations + 1;
 
 // What the left eye's denoise of this frame leaves for the right eye under stereo reuse: its new
@@ -130,9 +82,7 @@ constexpr int kDenoiseLevels = kMaxDenoiseIterations + 1;
 struct DenoiseSharedView {
   const float* moments = nullptr;
   const float* length = nullptr;
-  const ColourVariance* level0[2] = {nullptr, nullptr};
-  const PackedColourVariance* packed[2][kDenoiseLevels] = {};  ///< levels 1 and up
-  const uint32_t* peak = nullptr;                              ///< its level 0's largest value (levelScale)
+  const ColourVariance* levels[2][kDenoiseLevels] = {};
 };
 
 // One eye's denoising history: the filtered colours, moments, history length and guides of its
@@ -179,15 +129,9 @@ struct DenoiseFrameView {
   float* moments = nullptr;                        ///< becomes the history's
   float* length = nullptr;                         ///< becomes the history's
   float* depthGradient = nullptr;                  ///< 2 per pixel: the inverse depth's gradient (x, y), per pixel
-  // Per signal: level 0, and the packed levels 1 and up (kDenoiseLevels); a backend may let packed
-  // levels two apart share a buffer (ping-pong) unless a reusing right eye reads them.
-  ColourVariance* level0[2] = {nullptr, nullptr};
-  PackedColourVariance* packed[2][kDenoiseLevels] = {};
-  // Level 0's largest value over the pixels the eye filters (a float's bits; levelScale), folded in
-  // by the accumulation and the variance pass. The backend clears it before the frame; a reusing
-  // right eye starts from the left eye's instead, since its own pixels' filter also averages the
-  // left eye's levels (its levels must hold those values too).
-  uint32_t* peak = nullptr;
+  // Per signal and level (kDenoiseLevels); a backend may let levels two apart share a buffer
+  // (ping-pong) unless a reusing right eye reads them.
+  ColourVariance* levels[2][kDenoiseLevels] = {};
   ColourVariance* historyOut[2] = {nullptr, nullptr};  ///< the first pass's output: the next frame's history
   uint32_t* historyReusedFrom = nullptr;  ///< a reusing right eye: the next history's reusedFrom
   Vec3* out = nullptr;                             ///< the denoised image
@@ -326,31 +270,19 @@ PVR_HOST_DEVICE inline bool filtersPixel(const DenoiseFrameView& v, size_t pixel
 }
 
 // What one a-trous pass reads and writes, per signal: the eye's own level, the left eye's same
-// level for reused right pixels (level 0 for the first pass, else packed ones), and the next level
-// (packed; none for the last pass, which remodulates).
+// level for reused right pixels, and the next level (none for the last pass, which remodulates).
 struct AtrousLevels {
   const ColourVariance* in[2] = {nullptr, nullptr};
   const ColourVariance* sourceIn[2] = {nullptr, nullptr};
-  const PackedColourVariance* packedIn[2] = {nullptr, nullptr};
-  const PackedColourVariance* sourcePackedIn[2] = {nullptr, nullptr};
-  PackedColourVariance* out[2] = {nullptr, nullptr};
-  const uint32_t* peak = nullptr;        ///< the eye's (levelScale)
-  const uint32_t* sourcePeak = nullptr;  ///< the left eye's, for a reusing right eye
+  ColourVariance* out[2] = {nullptr, nullptr};
 };
 PVR_HOST_DEVICE inline AtrousLevels atrousLevels(const DenoiseFrameView& v, int iteration) {
   AtrousLevels l;
   for (int s = 0; s < 2; ++s) {
-    if (iteration == 0) {
-      l.in[s] = v.level0[s];
-      l.sourceIn[s] = v.source.level0[s];
-    } else {
-      l.packedIn[s] = v.packed[s][iteration];
-      l.sourcePackedIn[s] = v.source.packed[s][iteration];
-    }
-    if (iteration + 1 < v.params.iterations) l.out[s] = v.packed[s][iteration + 1];
+    l.in[s] = v.levels[s][iteration];
+    l.sourceIn[s] = v.source.levels[s][iteration];
+    if (iteration + 1 < v.params.iterations) l.out[s] = v.levels[s][iteration + 1];
   }
-  l.peak = v.peak;
-  l.sourcePeak = v.source.peak;
   return l;
 }
 
@@ -482,10 +414,8 @@ PVR_HOST_DEVICE inline bool accumulateUnfilteredPixel(const DenoiseFrameView& v,
 // contributed (for a reused right pixel: whether the left eye's had).
 // Each pass is written for S signals (1 or 2) known at compile time, so that the per-signal arrays
 // stay in registers on the GPU; the untemplated names choose S from the inputs.
-// `peak`, where given, takes the max with level 0's largest value at the pixel when that is final
-// (levelScale; the variance pass does it for the rest).
 template <int S>
-PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, int x, int y, float* peak) {
+PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   if (!filtersPixel(v, pixel)) return accumulateUnfilteredPixel<S>(v, pixel);
   if (v.historyReusedFrom) v.historyReusedFrom[pixel] = kNotReused;
@@ -594,9 +524,7 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
     // that falls; a refining history is the plain average, never a filtered one.
     c.variance *= fminf(1.0f, alpha * moving);
     if (refining) v.historyOut[s][pixel] = c;  // else the first a-trous pass (or remodulate) writes it
-    v.level0[s][pixel] = c;
-    // Level 0 is final here unless the variance pass replaces its variance (a short history).
-    if (peak && !(frames < kDenoiseShortHistory)) *peak = fmaxf(*peak, levelPeak(c));
+    v.levels[s][0][pixel] = c;
   }
   return used;
 }
@@ -606,9 +534,8 @@ PVR_HOST_DEVICE inline bool accumulateDenoisePixelOf(const DenoiseFrameView& v, 
 // moments of a 7x7 neighbourhood on the same surface, read at every other pixel (offsets -3, -1,
 // 1, 3 on each axis, and the pixel itself: 17 taps, a third of the window's 49, for the frames
 // after a cut or disocclusion, when every pixel of an eye takes this path at once).
-// `peak` takes the max with level 0's largest value at the pixels it changes.
 template <int S>
-PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v, int x, int y, float& peak) {
+PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v, int x, int y) {
   const size_t pixel = denoisePixel(v.camera, x, y);
   if (!(v.length[pixel] < kDenoiseShortHistory)) return;
   const DenoiseGuide p = v.guide[pixel];
@@ -640,9 +567,7 @@ PVR_HOST_DEVICE inline void estimateDenoiseVarianceOf(const DenoiseFrameView& v,
     }
   for (int s = 0; s < S; ++s) {
     const float mean = sum[2 * s] / total, meanSquare = sum[2 * s + 1] / total;
-    ColourVariance& level = v.level0[s][pixel];
-    level.variance = fmaxf(0.0f, meanSquare - mean * mean);
-    peak = fmaxf(peak, levelPeak(level));
+    v.levels[s][0][pixel].variance = fmaxf(0.0f, meanSquare - mean * mean);
   }
 }
 
@@ -671,20 +596,6 @@ struct MemoryTaps {
   const AtrousLevels& l;
   PVR_HOST_DEVICE DenoiseGuide guide(int, int, size_t q) const { return v.guide[q]; }
   PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const { return levelAt(v, l, s, q); }
-};
-// The same for the passes after the first, which read a packed level.
-struct PackedMemoryTaps {
-  const DenoiseFrameView& v;
-  const AtrousLevels& l;
-  LevelScale scale, sourceScale;
-  PVR_HOST_DEVICE PackedMemoryTaps(const DenoiseFrameView& view, const AtrousLevels& levels)
-      : v(view), l(levels), scale(levelScale(*levels.peak)),
-        sourceScale(levels.sourcePeak ? levelScale(*levels.sourcePeak) : LevelScale{}) {}
-  PVR_HOST_DEVICE DenoiseGuide guide(int, int, size_t q) const { return v.guide[q]; }
-  PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const {
-    const uint32_t source = reusedSourcePixel(v, q);
-    return source == kNotReused ? unpackLevel(l.packedIn[s][q], scale) : unpackLevel(l.sourcePackedIn[s][source], sourceScale);
-  }
 };
 
 // A 3x3 Gaussian of level 0's variance of signal s around the pixel over its own surface (the
@@ -773,14 +684,13 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
       }
     }
   ColourVariance result[2];
-  const LevelScale outScale = l.out[0] ? levelScale(*l.peak) : LevelScale{};
 #ifdef __CUDA_ARCH__
 #pragma unroll
 #endif
   for (int s = 0; s < signals; ++s) {
     result[s].colour = sum[s] / total[s];
     result[s].variance = variance[s] / (total[s] * total[s]);
-    if (l.out[s]) l.out[s][pixel] = packLevel(result[s], outScale);
+    if (l.out[s]) l.out[s][pixel] = result[s];
     if (iteration == 0 && !refiningPixel(v, pixel)) v.historyOut[s][pixel] = result[s];
   }
   if (iteration == v.params.iterations - 1) {
@@ -797,31 +707,25 @@ PVR_HOST_DEVICE inline void remodulateAccumulatedOf(const DenoiseFrameView& v, i
   const size_t pixel = denoisePixel(v.camera, x, y);
   Vec3 radiance{0, 0, 0};
   for (int s = 0; s < S; ++s) {
-    const ColourVariance c = v.level0[s][pixel];
+    const ColourVariance c = v.levels[s][0][pixel];
     v.historyOut[s][pixel] = c;
     radiance += c.colour;
   }
   writeDenoised(v, pixel, radiance);
 }
 
-PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, int x, int y, float* peak = nullptr) {
-  return v.twoSignals() == 2 ? accumulateDenoisePixelOf<2>(v, x, y, peak) : accumulateDenoisePixelOf<1>(v, x, y, peak);
+PVR_HOST_DEVICE inline bool accumulateDenoisePixel(const DenoiseFrameView& v, int x, int y) {
+  return v.twoSignals() == 2 ? accumulateDenoisePixelOf<2>(v, x, y) : accumulateDenoisePixelOf<1>(v, x, y);
 }
-PVR_HOST_DEVICE inline void estimateDenoiseVariance(const DenoiseFrameView& v, int x, int y, float& peak) {
-  if (v.twoSignals() == 2) estimateDenoiseVarianceOf<2>(v, x, y, peak);
-  else estimateDenoiseVarianceOf<1>(v, x, y, peak);
-}
-// An a-trous pass over memory: the first reads level 0, the later ones a packed level.
-template <class Taps>
-PVR_HOST_DEVICE inline void atrousDenoisePixelWith(const DenoiseFrameView& v, int iteration, const AtrousLevels& l,
-                                                   const Taps& taps, int x, int y) {
-  if (v.twoSignals() == 2) atrousDenoisePixelOf<2>(v, iteration, l, taps, x, y);
-  else atrousDenoisePixelOf<1>(v, iteration, l, taps, x, y);
+PVR_HOST_DEVICE inline void estimateDenoiseVariance(const DenoiseFrameView& v, int x, int y) {
+  if (v.twoSignals() == 2) estimateDenoiseVarianceOf<2>(v, x, y);
+  else estimateDenoiseVarianceOf<1>(v, x, y);
 }
 PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int iteration, const AtrousLevels& l, int x,
                                                int y) {
-  if (iteration == 0) atrousDenoisePixelWith(v, iteration, l, MemoryTaps{v, l}, x, y);
-  else atrousDenoisePixelWith(v, iteration, l, PackedMemoryTaps(v, l), x, y);
+  const MemoryTaps taps{v, l};
+  if (v.twoSignals() == 2) atrousDenoisePixelOf<2>(v, iteration, l, taps, x, y);
+  else atrousDenoisePixelOf<1>(v, iteration, l, taps, x, y);
 }
 PVR_HOST_DEVICE inline void remodulateAccumulated(const DenoiseFrameView& v, int x, int y) {
   if (v.twoSignals() == 2) remodulateAccumulatedOf<2>(v, x, y);
