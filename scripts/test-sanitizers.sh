@@ -13,6 +13,9 @@ export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1:detect_stack_use_after_return
 export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export PVR_REQUIRE_VULKAN=1
+# Sanitized frames take 10-20 times as long: the offscreen loop test keeps its deadline check at a
+# display rate they fit (tests/loop_offscreen.sh).
+export PVR_LOOP_TEST_REFRESH_HZ=0.25
 # install_consumer builds a program against the installed library without the sanitizer flags: a
 # packaging test, run by test.sh. The viewer's GLX driver (Mesa, loaded and unloaded by GLFW, its
 # frames without symbols) leaks 112 bytes at exit: the viewer runs with leak checks off, the

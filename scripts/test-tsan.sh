@@ -19,6 +19,9 @@ cmake --build "$build" -j"$(nproc)"
 # threads (not built with TSan) are theirs to check.
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:ignore_noninstrumented_modules=1:suppressions=$PWD/tests/sanitizers/tsan.supp"
 export PVR_REQUIRE_VULKAN=1
+# Sanitized frames take 10-20 times as long: the offscreen loop test keeps its deadline check at a
+# display rate they fit (tests/loop_offscreen.sh).
+export PVR_LOOP_TEST_REFRESH_HZ=0.25
 # Left out: what runs no photonvr threads (packaging, the fuzz inputs' replay, the viewer: GLFW's
 # X11 under Xvfb), and in CI (PVR_TSAN_QUICK=1) the ten tests that take over a minute each under
 # TSan (25 of its 50 minutes on 2 cores); they cover the same loops on more frames, and passed
