@@ -330,6 +330,16 @@ SyntheticFrame noisyPlane(int w, int h, unsigned seed) {
   return f;
 }
 
+// A right eye's inputs under stereo reuse: `own`, with per pixel the left pixel reused and the left
+// eye's (frame `leftFrame`) normals and denoised image.
+DenoiseInputs reusingRightEye(DenoiseInputs own, const std::vector<uint32_t>& reusedFrom, const SyntheticFrame& leftFrame,
+                              const Image& leftDenoised) {
+  own.reusedFrom = reusedFrom.data();
+  own.sourceNormal = leftFrame.normal.data();
+  own.sourceDenoised = leftDenoised.pixels.data();
+  return own;
+}
+
 // Stereo reuse: a right eye whose left half took the left eye's shading denoises that half once,
 // in the left eye. With the same inputs as the left eye its pixels come out bit for bit as the left
 // eye's (the reused pixels' filter levels are the left eye's), whatever its reused pixels rendered
@@ -349,10 +359,7 @@ TEST(Denoise, ReusedPixelsShareTheLeftEyesFilterAndHistory) {
   DenoiseInputs leftIn = f.inputs();
   leftIn.keepLevels = true;
   denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), leftIn, left);
-  DenoiseInputs rightIn = rendered.inputs();
-  rightIn.reusedFrom = reusedFrom.data();
-  rightIn.sourceNormal = f.normal.data();
-  rightIn.sourceDenoised = left.pixels.data();
+  const DenoiseInputs rightIn = reusingRightEye(rendered.inputs(), reusedFrom, f, left);
   EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right), 0u);
   for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
 
@@ -386,10 +393,7 @@ TEST(Denoise, ReusedPixelsFarBrighterThanTheRightEyesOwnKeepTheirValue) {
   DenoiseInputs leftIn = f.inputs();
   leftIn.keepLevels = true;
   denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), leftIn, left);
-  DenoiseInputs rightIn = f.inputs();
-  rightIn.reusedFrom = reusedFrom.data();
-  rightIn.sourceNormal = f.normal.data();
-  rightIn.sourceDenoised = left.pixels.data();
+  const DenoiseInputs rightIn = reusingRightEye(f.inputs(), reusedFrom, f, left);
   denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right);
   for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
 }

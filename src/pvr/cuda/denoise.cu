@@ -142,7 +142,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   };
   for (int s = 0; s < signals; ++s) {
     next.colour[s].reserve(pixels, "denoiser history");
-    for (int k = 0; k < std::max(params.iterations, 1); ++k) reserveCleared(state.levels[s][EyeState::levelBuffer(k, in)]);
+    for (int k = 0; k < EyeState::levelCount(params); ++k) reserveCleared(state.levels[s][EyeState::levelBuffer(k, in)]);
   }
   next.moments.reserve(4 * pixels, "denoiser moments");
   next.length.reserve(pixels, "denoiser history length");

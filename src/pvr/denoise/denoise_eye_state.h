@@ -2,7 +2,6 @@
 // One eye's denoising state over either backend's buffers (host vectors, device buffers: anything
 // with data()), and the frame's view of it: written once for the HostDenoiser and the GpuDenoiser,
 // which only size the buffers their own way and run the passes.
-
 #include <algorithm>
 
 #include "pvr/denoise/svgf.h"
@@ -36,12 +35,9 @@ struct DenoiseEyeState {
   Buffer<ColourVariance> levels[2][kDenoiseLevels];
 
   History& next() { return history[latest ^ 1]; }
-  // The buffer that holds level k (0 .. iterations - 1) this frame.
+  // Levels a frame writes (level 0 also without a-trous passes), and the buffer of level k.
+  static int levelCount(const DenoiseParams& params) { return std::max(params.iterations, 1); }
   static int levelBuffer(int k, const DenoiseInputs& in) { return in.keepLevels ? k : k & 1; }
-  // Levels this frame keeps: every one for a left eye that a right eye reuses.
-  static int levelsKept(const DenoiseParams& params, const DenoiseInputs& in) {
-    return in.keepLevels ? params.iterations + 1 : 0;
-  }
   // Starts a frame: a history of another size or number of signals is not read.
   void begin(const EyeCamera& c, const DenoiseInputs& in) {
     if (valid && (camera.width != c.width || camera.height != c.height || signals != (in.direct ? 2 : 1))) valid = false;
@@ -58,7 +54,7 @@ struct DenoiseEyeState {
     ++frames;
     camera = c;
     signals = in.direct ? 2 : 1;
-    keptLevels = levelsKept(params, in);
+    keptLevels = in.keepLevels ? levelCount(params) : 0;
     valid = true;
   }
 };
@@ -78,9 +74,8 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
   const auto& previous = state.history[state.latest];
   // A history that refers to the left eye's is read only while that is still there: the left eye
   // has ended at most one frame since (it writes its other buffer) at the same size.
-  const bool leftKept = !previous.referencesLeft ||
-                        (&state != &left && left.frames - previous.leftFrames <= 1 && left.camera.width == state.camera.width &&
-                         left.camera.height == state.camera.height);
+  const bool leftKept = !previous.referencesLeft || (left.frames - previous.leftFrames <= 1 && left.camera.width == state.camera.width &&
+                                                     left.camera.height == state.camera.height);
   if (state.valid && leftKept) {
     v.history.camera = state.camera;
     for (int s = 0; s < signals; ++s) v.history.colour[s] = previous.colour[s].data();
@@ -101,13 +96,13 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
   v.moments = next.moments.data();
   v.length = next.length.data();
   for (int s = 0; s < signals; ++s) {
-    for (int k = 0; k < std::max(params.iterations, 1); ++k) v.levels[s][k] = state.levels[s][State::levelBuffer(k, in)].data();
+    for (int k = 0; k < State::levelCount(params); ++k) v.levels[s][k] = state.levels[s][State::levelBuffer(k, in)].data();
     v.historyOut[s] = next.colour[s].data();
   }
   v.out = out;
-  if (in.reusedFrom) v.historyReusedFrom = next.reusedFrom.data();
   if (in.reusedFrom) {
-    if (eye != Eye::Right || !left.valid || left.keptLevels < params.iterations + 1 || left.signals != signals ||
+    v.historyReusedFrom = next.reusedFrom.data();
+    if (eye != Eye::Right || !left.valid || left.keptLevels < State::levelCount(params) || left.signals != signals ||
         !in.sourceDenoised)
       throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
     const auto& shared = left.history[left.latest];

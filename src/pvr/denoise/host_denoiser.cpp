@@ -1,6 +1,5 @@
 #include "pvr/denoise/host_denoiser.h"
 
-#include <algorithm>
 #include <atomic>
 
 #include "pvr/util/error.h"
@@ -29,7 +28,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   EyeState::History& next = state.next();
   for (int s = 0; s < signals; ++s) {
     next.colour[s].resize(pixels);
-    for (int k = 0; k < std::max(params.iterations, 1); ++k) state.levels[s][EyeState::levelBuffer(k, in)].resize(pixels);
+    for (int k = 0; k < EyeState::levelCount(params); ++k) state.levels[s][EyeState::levelBuffer(k, in)].resize(pixels);
   }
   next.moments.resize(4 * pixels);
   next.length.resize(pixels);
