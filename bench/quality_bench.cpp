@@ -48,12 +48,14 @@ struct Variant {
   StereoMode stereo = StereoMode::Separate;
   bool bicubicHistory = DenoiseParams().bicubicHistory;  ///< the denoiser's history read (--denoise-history)
   int iterations = DenoiseParams().iterations;           ///< a-trous passes (--denoise-iterations)
+  int directIterations = DenoiseParams().directIterations;  ///< of them, the direct signal's (--denoise-direct-iterations)
   // The suite's options with this variant's (the moving and the still head both render from it).
   RenderOptions options(const RenderOptions& suite) const {
     RenderOptions o = suite;
     o.denoise.enabled = denoise;
     o.denoise.params.bicubicHistory = bicubicHistory;
     o.denoise.params.iterations = iterations;
+    o.denoise.params.directIterations = directIterations;
     o.temporal.enabled = taa;
     o.stereo = stereo;
     o.photonBatches = photonBatches;
@@ -88,7 +90,14 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                   Boundary::Sphere, StereoMode::Separate, true},
                                  // Fewer a-trous passes (cheaper, a smaller footprint).
                                  {.name = "denoise, 4 passes", .denoise = true, .taa = false, .photonBatches = 1, .iterations = 4},
-                                 {.name = "denoise, 3 passes", .denoise = true, .taa = false, .photonBatches = 1, .iterations = 3}};
+                                 {.name = "denoise, 3 passes", .denoise = true, .taa = false, .photonBatches = 1, .iterations = 3},
+                                 // The direct signal through fewer passes than the photon map's (its noise is finer).
+                                 {.name = "denoise, direct 3 passes", .denoise = true, .taa = false, .photonBatches = 1,
+                                  .directIterations = 3},
+                                 {.name = "denoise, direct 2 passes", .denoise = true, .taa = false, .photonBatches = 1,
+                                  .directIterations = 2},
+                                 {.name = "denoise, direct 2 passes, gather reuse", .denoise = true, .taa = false,
+                                  .photonBatches = 1, .stereo = StereoMode::Gather, .directIterations = 2}};
 
 // The variants the run asked for (--quality-variants; all where empty), each checked: the first,
 // "raw", is every ratio's base and always runs.
@@ -321,7 +330,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"sampling", v.sampling == PixelSampling::BlueNoise ? "blue-noise" : "white"},
                       {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"},
                       {"stereo", stereoModeName(v.stereo)}, {"history", v.bicubicHistory ? "catmull-rom" : "bilinear"},
-                      {"denoise_iterations", v.iterations},
+                      {"denoise_iterations", v.iterations}, {"denoise_direct_iterations", v.directIterations},
                       {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});

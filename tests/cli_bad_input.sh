@@ -76,6 +76,9 @@ expect_error "--denoise-history must be catmull-rom or bilinear, got 'cubic'" re
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations 9 --eye-size 8x8
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations -1 --eye-size 8x8
 expect_error "--denoise-iterations" render cornell --denoise --denoise-iterations two --eye-size 8x8
+expect_error "--denoise-direct-iterations is for --denoise" render cornell --denoise-direct-iterations 2 --eye-size 8x8
+expect_error "--denoise-direct-iterations: the direct signal's a-trous passes must be between 1 and 8" render cornell --denoise --denoise-direct-iterations 0 --eye-size 8x8
+expect_error "--denoise-direct-iterations: the direct signal's a-trous passes must be between 1 and 8" render cornell --denoise --denoise-direct-iterations 9 --eye-size 8x8
 expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photon-batches 0 --eye-size 8x8
 expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photon-batches 65 --eye-size 8x8
 expect_error "--photon-batches: the photon batches must be between 1 and 64, and at most the photons" render cornell --photons 4x4 --photon-batches 32 --eye-size 8x8
@@ -180,6 +183,7 @@ expect_settings_error "radius" '{"radius": "-1"}'
 # Numbers outside the type they fill: an error naming the key, never a cast (undefined there).
 expect_settings_error "k must be an integer" '{"k": 1e20}'
 expect_settings_error "denoise_iterations must be an integer" '{"denoise_iterations": 2.5}'
+expect_settings_error "denoise_direct_iterations must be an integer" '{"denoise_direct_iterations": 1e20}'
 expect_settings_error "exposure must be a finite number" '{"exposure": 1e300}'
 expect_settings_error "the head pose must be a finite number" '{"head": {"position": [0, 1e39, 0], "orientation": [0, 0, 0, 1]}}'
 expect_error "--acuity must be" render cornell --foveated --acuity sharp "${small[@]}"

@@ -345,33 +345,74 @@ DenoiseInputs reusingRightEye(DenoiseInputs own, const std::vector<uint32_t>& re
 // eye's (the reused pixels' filter levels are the left eye's), whatever its reused pixels rendered
 // themselves; and next frame, shaded by itself, it carries the left eye's history on.
 TEST(Denoise, ReusedPixelsShareTheLeftEyesFilterAndHistory) {
-  const int w = 64, h = 48;
-  HostDenoiser denoiser;
-  Image left, right;
-  SyntheticFrame f = noisyPlane(w, h, 21);
-  SyntheticFrame rendered = f;  // the right eye's own rendering, 1000x off where it reused
-  std::vector<uint32_t> reusedFrom(size_t(w) * h, kNotReused);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w / 2; ++x) {
-      reusedFrom[f.at(x, y)] = uint32_t(f.at(x, y));
-      rendered.image[f.at(x, y)] *= 1000.0f, rendered.direct[f.at(x, y)] *= 1000.0f;
+  // Also where the direct signal stops before the photon map's (its last level, kept by the left
+  // eye, is read by the right eye's neighbours at the later passes).
+  DenoiseParams directTwoPasses;
+  directTwoPasses.directIterations = 2;
+  for (const DenoiseParams& params : {DenoiseParams(), directTwoPasses}) {
+    SCOPED_TRACE("direct signal's passes " + std::to_string(params.directIterations));
+    const int w = 64, h = 48;
+    HostDenoiser denoiser;
+    Image left, right;
+    SyntheticFrame f = noisyPlane(w, h, 21);
+    SyntheticFrame rendered = f;  // the right eye's own rendering, 1000x off where it reused
+    std::vector<uint32_t> reusedFrom(size_t(w) * h, kNotReused);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w / 2; ++x) {
+        reusedFrom[f.at(x, y)] = uint32_t(f.at(x, y));
+        rendered.image[f.at(x, y)] *= 1000.0f, rendered.direct[f.at(x, y)] *= 1000.0f;
+      }
+    DenoiseInputs leftIn = f.inputs();
+    leftIn.keepLevels = true;
+    denoiser.denoise(Eye::Left, f.camera, params, leftIn, left);
+    const DenoiseInputs rightIn = reusingRightEye(rendered.inputs(), reusedFrom, f, left);
+    EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, params, rightIn, right), 0u);
+    for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
+
+    // Next frame nothing is reused: every right pixel keeps a history (the reused ones the left
+    // eye's) and the two eyes stay alike to the bit.
+    SyntheticFrame second = noisyPlane(w, h, 22);
+    denoiser.denoise(Eye::Left, f.camera, params, second.inputs(), left);
+    EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, params, second.inputs(), right), size_t(w) * h);
+    for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
+
+    // The left eye must have kept its levels for a reusing right eye.
+    EXPECT_THROW(denoiser.denoise(Eye::Right, f.camera, params, rightIn, right), Error);
+  }
+}
+
+// --denoise-direct-iterations: the direct signal is filtered by the first passes only, the photon
+// map's by all, each on its own. Over a moving history of frames, a frame with both signals comes
+// out as the sum of the direct signal alone through that many passes and the photon map's alone
+// through all of them (within rounding: the sums are taken in another order), and the direct
+// signal alone comes out bit for bit as a filter of that many passes gives it.
+TEST(Denoise, TheDirectSignalTakesOnlyItsPasses) {
+  const int w = 64, h = 48, directPasses = 2;
+  DenoiseParams split, all, fewer;
+  split.directIterations = directPasses;
+  fewer.iterations = fewer.directIterations = directPasses;
+  HostDenoiser both, directAlone, directShort, photonMapAlone, unsplit;
+  Image out, direct, directReference, photonMap, unsplitOut;
+  double difference = 0;
+  for (int frame = 0; frame < 4; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    const SyntheticFrame f = noisyPlane(w, h, 40 + unsigned(frame));
+    SyntheticFrame onlyDirect = f, onlyPhotonMap = f;
+    for (size_t i = 0; i < f.image.size(); ++i) onlyDirect.image[i] = f.direct[i], onlyPhotonMap.image[i] = f.image[i] - f.direct[i], onlyPhotonMap.direct[i] = Vec3(0.0f);
+    both.denoise(Eye::Left, f.camera, split, f.inputs(), out);
+    directAlone.denoise(Eye::Left, f.camera, split, onlyDirect.inputs(), direct);
+    directShort.denoise(Eye::Left, f.camera, fewer, onlyDirect.inputs(), directReference);
+    photonMapAlone.denoise(Eye::Left, f.camera, all, onlyPhotonMap.inputs(), photonMap);
+    unsplit.denoise(Eye::Left, f.camera, all, f.inputs(), unsplitOut);
+    for (size_t i = 0; i < out.pixels.size(); ++i) {
+      ASSERT_EQ(direct.pixels[i], directReference.pixels[i]) << "pixel " << i;
+      const Vec3 sum = direct.pixels[i] + photonMap.pixels[i];
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(out.pixels[i][c], sum[c], 1e-6f * std::max(1.0f, sum[c])) << "pixel " << i;
     }
-  DenoiseInputs leftIn = f.inputs();
-  leftIn.keepLevels = true;
-  denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), leftIn, left);
-  const DenoiseInputs rightIn = reusingRightEye(rendered.inputs(), reusedFrom, f, left);
-  EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right), 0u);
-  for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
-
-  // Next frame nothing is reused: every right pixel keeps a history (the reused ones the left
-  // eye's) and the two eyes stay alike to the bit.
-  SyntheticFrame second = noisyPlane(w, h, 22);
-  denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), second.inputs(), left);
-  EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), second.inputs(), right), size_t(w) * h);
-  for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
-
-  // The left eye must have kept its levels for a reusing right eye.
-  EXPECT_THROW(denoiser.denoise(Eye::Right, f.camera, DenoiseParams(), rightIn, right), Error);
+    difference += compareImages(out, unsplitOut);
+  }
+  // And it is not the filter of all passes for both: the direct signal is filtered less.
+  EXPECT_GT(difference / 4, 1e-3);
 }
 
 // The same where reused pixels are far brighter than those the right eye shades itself: its own

@@ -308,6 +308,7 @@ TEST(FrameOptions, ErrorsNameTheOptionAndTheCommandLineItsFlag) {
       {RenderOption::TaaBlend, [](RenderOptions& o, StereoRig&) { o.temporal.enabled = true, o.temporal.taa.blend = 0; }, "--taa-blend"},
       {RenderOption::Stereo, [](RenderOptions& o, StereoRig&) { o.stereo = StereoMode::Gather, o.eyes[1] = false; }, "--stereo"},
       {RenderOption::DenoiseIterations, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.iterations = 9; }, "--denoise-iterations"},
+      {RenderOption::DenoiseDirectIterations, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.directIterations = 0; }, "--denoise-direct-iterations"},
       {RenderOption::DenoiseParameter, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.colourAlpha = 0; }, "--denoise"},
       {RenderOption::DenoiseParameter, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.depthTolerance = NAN; }, "--denoise"},
       {RenderOption::DenoiseParameter, [](RenderOptions& o, StereoRig&) { o.denoise.enabled = true, o.denoise.params.refineAlpha = 1; }, "--denoise"},

@@ -102,6 +102,7 @@ struct RenderArgs {
   std::string taaBlend;      // empty: TaaParams' default
   bool denoise = false;
   int denoiseIterations = DenoiseParams().iterations;
+  int denoiseDirectIterations = DenoiseParams().directIterations;
   bool noRefine = false;
   std::string denoiseHistory;  // empty: DenoiseParams' default
   int photonBatches = 1;     // a rolling photon map's slices, one retraced per frame
@@ -168,6 +169,8 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     text("denoise_history", "--denoise-history", a.denoiseHistory);
     if (j.contains("denoise_iterations") && !given("--denoise-iterations"))
       a.denoiseIterations = jsonNumber<int>(j["denoise_iterations"], "denoise_iterations");
+    if (j.contains("denoise_direct_iterations") && !given("--denoise-direct-iterations"))
+      a.denoiseDirectIterations = jsonNumber<int>(j["denoise_direct_iterations"], "denoise_direct_iterations");
     if (j.contains("k") && !given("--k")) a.k = jsonNumber<int>(j["k"], "k");
     if (j.contains("exposure") && !given("--exposure")) a.exposure = jsonNumber<float>(j["exposure"], "exposure");
     if (j.contains("scene") && !given("scene")) a.scene = j["scene"].get<std::string>();
@@ -254,6 +257,10 @@ void addDenoiseOptions(CLI::App& cmd, RenderArgs& a) {
                "accumulated over frames by reprojection, filtered by an edge-aware a-trous wavelet");
   cmd.add_option("--denoise-iterations", a.denoiseIterations,
                  "A-trous passes of --denoise (0: temporal accumulation only; at most 8)")
+      ->capture_default_str();
+  cmd.add_option("--denoise-direct-iterations", a.denoiseDirectIterations,
+                 "Of those passes, how many filter the direct (shadow-ray) light; the photon-map light takes them all "
+                 "(1..8; more than --denoise-iterations: all)")
       ->capture_default_str();
   cmd.add_option("--photon-batches", a.photonBatches,
                  "A rolling photon map: the photons in N slices, one retraced per frame, so consecutive frames share "
@@ -396,6 +403,8 @@ RenderOptions optionsFromArgs(const RenderArgs& a, StereoRig& rig) {
   }
   if (a.denoiseIterations != DenoiseParams().iterations && !a.denoise)
     throw Error("--denoise-iterations is for --denoise");
+  if (a.denoiseDirectIterations != DenoiseParams().directIterations && !a.denoise)
+    throw Error("--denoise-direct-iterations is for --denoise");
   if (a.noRefine && !a.denoise) throw Error("--no-refine is for --denoise");
   if (!a.denoiseHistory.empty()) {
     if (!a.denoise) throw Error("--denoise-history is for --denoise");
@@ -406,6 +415,7 @@ RenderOptions optionsFromArgs(const RenderArgs& a, StereoRig& rig) {
   options.denoise.params.refineWhenStill = !a.noRefine;
   options.denoise.enabled = a.denoise;
   options.denoise.params.iterations = a.denoiseIterations;
+  options.denoise.params.directIterations = a.denoiseDirectIterations;
   options.photonBatches = a.photonBatches;
   validateOptions(options, rig);  // before the scene-dependent work: a bad value need not wait for it
   return options;

@@ -42,6 +42,7 @@ const char* flagOf(RenderOption option) {
     case RenderOption::TaaDepthTolerance: return "--taa-depth-tolerance";
     case RenderOption::Stereo: return "--stereo";
     case RenderOption::DenoiseIterations: return "--denoise-iterations";
+    case RenderOption::DenoiseDirectIterations: return "--denoise-direct-iterations";
     case RenderOption::PhotonBatches: return "--photon-batches";
     case RenderOption::DenoiseParameter: return "--denoise";
     case RenderOption::Density: return "--density";

@@ -5,6 +5,7 @@ namespace pvr {
 
 struct DenoiseParams {
   int iterations = 5;            ///< a-trous passes (0: temporal accumulation only)
+  int directIterations = 5;      ///< of them, the passes of the direct (shadow-ray) signal (1..iterations; svgf.h)
   float colourAlpha = 0.2f;      ///< the current frame's least weight in the accumulated colour
   float momentsAlpha = 0.2f;     ///< the same for the luminance moments
   float sigmaLuminance = 4.0f;   ///< luminance edge-stopping, in local standard deviations

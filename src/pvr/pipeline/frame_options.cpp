@@ -96,6 +96,10 @@ void validateOptions(const RenderOptions& o, const StereoRig& rig) {
     if (d.iterations < 0 || d.iterations > kMaxDenoiseIterations)
       throw OptionError(RenderOption::DenoiseIterations,
                         "the denoiser's a-trous passes must be between 0 and " + std::to_string(kMaxDenoiseIterations));
+    if (d.directIterations < 1 || d.directIterations > kMaxDenoiseIterations)
+      throw OptionError(RenderOption::DenoiseDirectIterations,
+                        "the direct signal's a-trous passes must be between 1 and " +
+                            std::to_string(kMaxDenoiseIterations) + " (more than the filter's passes count as all)");
     if (!(d.colourAlpha > 0.0f && d.colourAlpha <= 1.0f) || !(d.momentsAlpha > 0.0f && d.momentsAlpha <= 1.0f))
       throw OptionError(RenderOption::DenoiseParameter, "the denoiser's history weights must be in (0, 1]");
     if (!(d.stillPosition >= 0.0f) || !std::isfinite(d.stillPosition) || !(d.stillAngleDegrees >= 0.0f) ||

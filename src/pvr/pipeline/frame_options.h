@@ -106,7 +106,7 @@ constexpr int kMaxShadowRays = 64;
 // line names its flag).
 enum class RenderOption : int {
   Photons, PhotonDepth, Radius, K, SamplesPerPixel, SpecularDepth, ShadowRays, EyeSize, Ipd, Kernel, Gaze, TaaBlend,
-  TaaDepthTolerance, Stereo, DenoiseIterations, DenoiseParameter, PhotonBatches, Density, CacheCell,
+  TaaDepthTolerance, Stereo, DenoiseIterations, DenoiseDirectIterations, DenoiseParameter, PhotonBatches, Density, CacheCell,
 };
 
 constexpr int kMaxPhotonBatches = 64;
