@@ -136,6 +136,13 @@ Flicker flicker(const Image& a, const Image& b, const Image& referenceA, const I
   return {shown / level, truth / level, unexplained / level};
 }
 
+// Pixels with a non-finite channel (a MISMATCH whatever the error says).
+size_t nonFinitePixels(const Image& image) {
+  return size_t(std::count_if(image.pixels.begin(), image.pixels.end(), [](const Vec3& c) {
+    return !std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z);
+  }));
+}
+
 // Mean absolute change of luminance from a to b over a's mean luminance.
 double change(const Image& a, const Image& b) {
   double diff = 0, level = 0;
@@ -353,6 +360,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       std::unique_ptr<FrameRenderer> renderer = makeFrameRenderer(kind, scene);
       const RenderOptions vo = v.options(o);
       ReferenceError at[3];
+      size_t nonFinite[3] = {0, 0, 0};  // pixels of both eyes at each compared frame
       Image last, stillShown;
       std::vector<double> changes;  // after the still frames, moving: frame-to-frame change of the left eye
       for (int f = 0; f < kStillFrames + kAfterStill; ++f) {
@@ -367,6 +375,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
         const int slot = f == 0 ? 0 : f == kHz - 1 ? 1 : f == kStillFrames - 1 ? 2 : -1;
         FrameResult r = renderer->render(start, vo, slot >= 0);
         if (slot < 0) continue;
+        for (int e = 0; e < 2; ++e) nonFinite[slot] += nonFinitePixels(r.eyes[e].image);
         ReferenceError e[2] = {compareToReference(r.eyes[0].image, still[0]), compareToReference(r.eyes[1].image, still[1])};
         at[slot] = e[0];
         at[slot].relMse = 0.5 * (e[0].relMse + e[1].relMse);
@@ -380,7 +389,11 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       std::sort(settled.begin(), settled.end());
       const double median = settled.empty() ? 0.0 : settled[settled.size() / 2];
       const double pop = median > 0 ? *std::max_element(changes.begin(), changes.begin() + 10) / median : 0.0;
-      const bool ok = at[2].relMse < 1.0 && (!v.denoise || at[2].relMse < at[0].relMse);
+      const bool ok = at[2].relMse < 1.0 && (!v.denoise || at[2].relMse < at[0].relMse) &&
+                      nonFinite[0] + nonFinite[1] + nonFinite[2] == 0;
+      if (nonFinite[0] + nonFinite[1] + nonFinite[2])
+        std::printf("| %s | %s | non-finite pixels (both eyes) at frame 1, after 1 s, after 5 s: %zu, %zu, %zu |\n",
+                    scene.name.c_str(), v.name, nonFinite[0], nonFinite[1], nonFinite[2]);
       failures += ok ? 0 : 1;
       std::printf("| %s | %s | %.5f | %.5f | %.3f | %.5f | %.1f dB | %.3f | %.2f | %s |\n", scene.name.c_str(), v.name,
                   at[0].relMse, at[1].relMse, at[0].relMse > 0 ? at[1].relMse / at[0].relMse : 1.0, at[2].relMse,
@@ -400,6 +413,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"radius", o.gather.density.radius}, {"frames", kStillFrames},
                       {"rel_mse_frame_1", at[0].relMse}, {"rel_mse_1s", at[1].relMse}, {"rel_mse_5s", at[2].relMse},
                       {"psnr_5s_db", at[2].psnr}, {"ssim_5s", at[2].ssim}, {"return_to_moving_pop", pop},
+                      {"non_finite_pixels", {nonFinite[0], nonFinite[1], nonFinite[2]}},
                       {"return_changes", changes},
                       {"reference_passes", 4 * args.referencePasses},
                       {"reference_estimated_rel_mse", {estimated[0], estimated[1]}}, {"check", ok ? "ok" : "MISMATCH"}});

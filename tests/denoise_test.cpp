@@ -415,6 +415,47 @@ TEST(Denoise, TheDirectSignalTakesOnlyItsPasses) {
   EXPECT_GT(difference / 4, 1e-3);
 }
 
+// No pass reads what neither this frame nor the history's frame wrote: with every buffer the passes
+// write filled with NaN before each frame (HostDenoiser::poisonUnwritten), both eyes come out bit
+// for bit as without, over frames where the right eye reuses a different third of its pixels each
+// frame (its history then refers to the left eye's), with background beside the surfaces, moving
+// and then refining, with the direct signal through all passes and through two.
+TEST(Denoise, NoPassReadsWhatNoFrameWrote) {
+  const int w = 48, h = 40;
+  DenoiseParams directTwoPasses;
+  directTwoPasses.directIterations = 2;
+  for (const DenoiseParams& params : {DenoiseParams(), directTwoPasses}) {
+    HostDenoiser clean, poisoned;
+    poisoned.poisonUnwritten(true);
+    for (int frame = 0; frame < 12; ++frame) {
+      SCOPED_TRACE("direct passes " + std::to_string(params.directIterations) + ", frame " + std::to_string(frame));
+      SyntheticFrame f = noisyPlane(w, h, 60 + unsigned(frame));
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < 6; ++x) f.inverseDepth[f.at(x, y)] = 0.0f, f.image[f.at(x, y)] = Vec3(0.5f);  // sky
+      std::vector<uint32_t> reusedFrom(size_t(w) * h, kNotReused);
+      for (int y = 0; y < h; ++y)
+        for (int x = 6; x < w; ++x)
+          if ((x + y + frame) % 3 == 0) reusedFrom[f.at(x, y)] = uint32_t(f.at(x, y));
+      const int still = frame < 6 ? 0 : frame - 5;
+      Image out[2][2];  // [denoiser][eye]
+      HostDenoiser* denoisers[2] = {&clean, &poisoned};
+      for (int d = 0; d < 2; ++d) {
+        DenoiseInputs leftIn = f.inputs();
+        leftIn.keepLevels = true;
+        denoisers[d]->denoise(Eye::Left, f.camera, params, leftIn, out[d][0], still);
+        denoisers[d]->denoise(Eye::Right, f.camera, params, reusingRightEye(f.inputs(), reusedFrom, f, out[d][0]),
+                              out[d][1], still);
+      }
+      for (int e = 0; e < 2; ++e)
+        for (size_t i = 0; i < out[0][e].pixels.size(); ++i) {
+          const Vec3 c = out[1][e].pixels[i];
+          ASSERT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z)) << "eye " << e << ", pixel " << i;
+          ASSERT_EQ(c, out[0][e].pixels[i]) << "eye " << e << ", pixel " << i;
+        }
+    }
+  }
+}
+
 // The same where reused pixels are far brighter than those the right eye shades itself: its own
 // pixels average the left eye's bright levels (here at the a-trous passes' longer steps, beyond a
 // dim reused strip that keeps them out of its own pixels' variance windows), and must take them

@@ -1,6 +1,8 @@
 #include "pvr/denoise/host_denoiser.h"
 
+#include <algorithm>
 #include <atomic>
+#include <limits>
 
 #include "pvr/util/error.h"
 #include "pvr/util/parallel_for.h"
@@ -36,6 +38,20 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   if (in.reusedFrom) next.reusedFrom.resize(pixels);
   state.depthGradient.resize(2 * pixels);
   out = Image(camera.width, camera.height);
+  if (poison_) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    ColourVariance unwritten;
+    unwritten.colour = Vec3(nan), unwritten.variance = nan;
+    for (int s = 0; s < signals; ++s) {
+      std::fill(next.colour[s].begin(), next.colour[s].end(), unwritten);
+      for (int k = 0; k < EyeState::levelCount(params); ++k) {
+        auto& level = state.levels[s][EyeState::levelBuffer(k, in)];
+        std::fill(level.begin(), level.end(), unwritten);
+      }
+    }
+    std::fill(next.moments.begin(), next.moments.end(), nan);
+    std::fill(next.length.begin(), next.length.end(), nan);
+  }
   const DenoiseFrameView v =
       denoiseFrameView(eye, camera, params, in, stillFrames, state, eyes_[int(Eye::Left)], out.pixels.data());
 

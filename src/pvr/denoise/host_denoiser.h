@@ -16,12 +16,18 @@ class HostDenoiser {
   size_t denoise(Eye eye, const EyeCamera& camera, const DenoiseParams& params, const DenoiseInputs& in, Image& out,
                  int stillFrames = 0);
   void forget(Eye eye) { eyes_[int(eye)].valid = false; }
+  // Tests: before each frame's passes, fill what they write (the next history's colours, moments
+  // and lengths, the filter levels) with NaN, so that a read of anything this frame or the history's
+  // frame did not write shows in the image (a fresh buffer's zeros would hide it; the GPU's memory
+  // holds whatever it held).
+  void poisonUnwritten(bool on) { poison_ = on; }
 
  private:
   template <class T>
   using HostBuffer = std::vector<T>;
   using EyeState = DenoiseEyeState<HostBuffer>;
   EyeState eyes_[2];
+  bool poison_ = false;
 };
 
 }  // namespace pvr
