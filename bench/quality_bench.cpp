@@ -136,13 +136,6 @@ Flicker flicker(const Image& a, const Image& b, const Image& referenceA, const I
   return {shown / level, truth / level, unexplained / level};
 }
 
-// Pixels with a non-finite channel (a MISMATCH whatever the error says).
-size_t nonFinitePixels(const Image& image) {
-  return size_t(std::count_if(image.pixels.begin(), image.pixels.end(), [](const Vec3& c) {
-    return !std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z);
-  }));
-}
-
 // Mean absolute change of luminance from a to b over a's mean luminance.
 double change(const Image& a, const Image& b) {
   double diff = 0, level = 0;

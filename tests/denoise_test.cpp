@@ -449,7 +449,7 @@ TEST(Denoise, NoPassReadsWhatNoFrameWrote) {
       for (int e = 0; e < 2; ++e)
         for (size_t i = 0; i < out[0][e].pixels.size(); ++i) {
           const Vec3 c = out[1][e].pixels[i];
-          ASSERT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z)) << "eye " << e << ", pixel " << i;
+          ASSERT_TRUE(isFinite(c)) << "eye " << e << ", pixel " << i;
           ASSERT_EQ(c, out[0][e].pixels[i]) << "eye " << e << ", pixel " << i;
         }
     }

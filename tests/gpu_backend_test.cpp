@@ -466,9 +466,7 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
         ASSERT_EQ(cudaMemcpy(inverseDepth.data(), gpu.deviceInverseDepth(Eye(e)), pixels * sizeof(float),
                              cudaMemcpyDeviceToHost),
                   cudaSuccess);
-        const auto bad = std::find_if(image.begin(), image.end(), [](const Vec3& c) {
-          return !std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z);
-        });
+        const auto bad = std::find_if(image.begin(), image.end(), [](const Vec3& c) { return !isFinite(c); });
         where += "; eye " + std::to_string(e) + ": " + std::to_string(counts[e]) + " pixels";
         if (bad == image.end()) continue;
         const size_t i = size_t(bad - image.begin());

@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "pvr/foveation/mask.h"
+#include "pvr/image/image_compare.h"
 #include "pvr/loop/frame_loop.h"
 #include "pvr/loop/offscreen_presenter.h"
 #include "pvr/util/error.h"
@@ -142,8 +143,7 @@ class SoakPresenter : public Presenter {
       deviceCheck_.nonFinitePixels(f.renderer, counts);
       nonFinite = counts[0] + counts[1];
     } else {
-      for (const EyeResult& eye : f.result->eyes)
-        for (const Vec3& p : eye.image.pixels) nonFinite += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+      for (const EyeResult& eye : f.result->eyes) nonFinite += nonFinitePixels(eye.image);
     }
     if (nonFinite && nonFinite_ == 0) firstNonFiniteFrame_ = frame_;
     nonFinite_ += nonFinite;

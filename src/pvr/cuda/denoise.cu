@@ -186,7 +186,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
       const int step = 1 << i, tilesX = (camera.width + step * kTile - 1) / (step * kTile);
       const int tilesY = (camera.height + step * kTile - 1) / (step * kTile);
       const unsigned blocks = unsigned(step * step * tilesX * tilesY);
-      if (signals == 2) launch("denoise a-trous", atrousTileKernel<2>, blocks, block, 0, stream, v, i, levels, tilesX);
+      if (levels.signals == 2) launch("denoise a-trous", atrousTileKernel<2>, blocks, block, 0, stream, v, i, levels, tilesX);
       else launch("denoise a-trous", atrousTileKernel<1>, blocks, block, 0, stream, v, i, levels, tilesX);
     }
   }

@@ -28,30 +28,24 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   const int signals = in.direct ? 2 : 1;
   state.begin(camera, in);
   EyeState::History& next = state.next();
+  // What the passes write, sized (and under poisonUnwritten filled with NaN first).
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  ColourVariance unwritten;
+  unwritten.colour = Vec3(nan), unwritten.variance = nan;
+  auto written = [&](auto& buffer, size_t n, const auto& poison) {
+    buffer.resize(n);
+    if (poison_) std::fill(buffer.begin(), buffer.end(), poison);
+  };
   for (int s = 0; s < signals; ++s) {
-    next.colour[s].resize(pixels);
-    for (int k = 0; k < EyeState::levelCount(params); ++k) state.levels[s][EyeState::levelBuffer(k, in)].resize(pixels);
+    written(next.colour[s], pixels, unwritten);
+    for (int k = 0; k < EyeState::levelCount(params); ++k) written(state.levels[s][EyeState::levelBuffer(k, in)], pixels, unwritten);
   }
-  next.moments.resize(4 * pixels);
-  next.length.resize(pixels);
+  written(next.moments, 4 * pixels, nan);
+  written(next.length, pixels, nan);
   next.guide.resize(pixels);
   if (in.reusedFrom) next.reusedFrom.resize(pixels);
   state.depthGradient.resize(2 * pixels);
   out = Image(camera.width, camera.height);
-  if (poison_) {
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    ColourVariance unwritten;
-    unwritten.colour = Vec3(nan), unwritten.variance = nan;
-    for (int s = 0; s < signals; ++s) {
-      std::fill(next.colour[s].begin(), next.colour[s].end(), unwritten);
-      for (int k = 0; k < EyeState::levelCount(params); ++k) {
-        auto& level = state.levels[s][EyeState::levelBuffer(k, in)];
-        std::fill(level.begin(), level.end(), unwritten);
-      }
-    }
-    std::fill(next.moments.begin(), next.moments.end(), nan);
-    std::fill(next.length.begin(), next.length.end(), nan);
-  }
   const DenoiseFrameView v =
       denoiseFrameView(eye, camera, params, in, stillFrames, state, eyes_[int(Eye::Left)], out.pixels.data());
 

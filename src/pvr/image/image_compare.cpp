@@ -118,4 +118,8 @@ ReferenceError compareToReference(const Image& test, const Image& reference, con
   return out;
 }
 
+size_t nonFinitePixels(const Image& image) {
+  return size_t(std::count_if(image.pixels.begin(), image.pixels.end(), [](const Vec3& c) { return !isFinite(c); }));
+}
+
 }  // namespace pvr

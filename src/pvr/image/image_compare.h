@@ -16,6 +16,10 @@ struct ImageComparison {
   size_t pixels = 0;               ///< pixels compared
 };
 
+// Pixels with a NaN or infinite channel (the GPU counts its images' on the device:
+// cuda/image_checks.h).
+size_t nonFinitePixels(const Image& image);
+
 // Compares `test` with `reference` over the pixels whose `mask` entry is non-zero (every pixel if
 // the mask is empty). Throws pvr::Error if the sizes differ.
 ImageComparison compareDisplayed(const Image& test, const Image& reference, const std::vector<uint8_t>& mask = {},
