@@ -382,9 +382,9 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       std::sort(settled.begin(), settled.end());
       const double median = settled.empty() ? 0.0 : settled[settled.size() / 2];
       const double pop = median > 0 ? *std::max_element(changes.begin(), changes.begin() + 10) / median : 0.0;
-      const bool ok = at[2].relMse < 1.0 && (!v.denoise || at[2].relMse < at[0].relMse) &&
-                      nonFinite[0] + nonFinite[1] + nonFinite[2] == 0;
-      if (nonFinite[0] + nonFinite[1] + nonFinite[2])
+      const size_t anyNonFinite = nonFinite[0] + nonFinite[1] + nonFinite[2];
+      const bool ok = at[2].relMse < 1.0 && (!v.denoise || at[2].relMse < at[0].relMse) && anyNonFinite == 0;
+      if (anyNonFinite)
         std::printf("| %s | %s | non-finite pixels (both eyes) at frame 1, after 1 s, after 5 s: %zu, %zu, %zu |\n",
                     scene.name.c_str(), v.name, nonFinite[0], nonFinite[1], nonFinite[2]);
       failures += ok ? 0 : 1;
