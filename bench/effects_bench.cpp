@@ -117,21 +117,20 @@ ControlProfile calibrate(FrameRenderer& renderer, const Scene& scene, const Ster
     s.radius = int(i);
     p.radiusError[i] = int(i) == top.radius ? 0.0 : meanError(run(s)) - topError;
   }
-  double denoiseMs = 0;
-  int denoiseIterations = 0;
+  double denoiseMs = 0, denoisePasses = 0;
   for (size_t i = 0; i < p.denoiseIterations.size(); ++i) {
     ControlSetting s = top;
     s.denoise = int(i);
     const Measured m = int(i) == top.denoise ? best : run(s);
     p.denoiseError[i] = meanError(m) - topError;
-    if (p.denoiseIterations[i] > 0) denoiseMs += m.denoiseMs, denoiseIterations += p.denoiseIterations[i];
+    if (p.denoiseIterations[i] > 0) denoiseMs += m.denoiseMs, denoisePasses += p.denoisePasses(int(i));
   }
   // The errors were measured from the best setting's denoiser: make them relative to none.
   const double none = p.denoiseError[0];
   for (double& e : p.denoiseError) e -= none;
   p.topError += none;
   for (double& e : p.photonError) e = std::max(0.0, e);
-  if (denoiseIterations > 0) p.denoiseMsPerIteration = denoiseMs / denoiseIterations;
+  if (denoisePasses > 0) p.denoiseMsPerIteration = denoiseMs / denoisePasses;
   {
     ControlSetting s = top;
     s.foveated = true;

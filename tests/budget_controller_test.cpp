@@ -318,6 +318,12 @@ TEST(BudgetController, OptionsCarryTheSetting) {
   EXPECT_EQ(o.photonsX, c.profile().photonSides.front());
   EXPECT_TRUE(o.denoise.enabled);
   EXPECT_EQ(o.denoise.params.iterations, c.profile().denoiseIterations[2]);
+  EXPECT_EQ(o.denoise.params.directIterations, c.profile().denoiseDirectIterations[2]);
+  // The direct signal through fewer passes than the photon map's: its step costs less than all
+  // passes over both signals, more than the photon map's passes alone.
+  ASSERT_LT(c.profile().denoiseDirectIterations[2], c.profile().denoiseIterations[2]);
+  EXPECT_LT(c.scaleOf(s).denoiseMs, double(c.profile().denoiseIterations[2]));
+  EXPECT_GT(c.scaleOf(s).denoiseMs, c.profile().photonMapPassShare * c.profile().denoiseIterations[2]);
   EXPECT_DOUBLE_EQ(c.scaleOf(s).densityMs, c.profile().densityFixedShare) << "only the density stage's fixed part runs";
   // Options asking for less than gi cap the group.
   base.gather.groupEffects[1] = uint8_t(EffectLevel::Shadows);
@@ -380,6 +386,32 @@ TEST(BudgetController, ProfilesRoundTripAndBadOnesAreRefused) {
   j = p.toJson();
   j["cost"]["foveated_samples"] = 0.0;
   EXPECT_TRUE(refused(j.dump()));
+  // The denoise ladder: direct passes within 1..the step's passes, steps rising in cost.
+  j = p.toJson();
+  j["denoise_direct_iterations"][1] = j["denoise_iterations"][1].get<int>() + 1;
+  EXPECT_TRUE(refused(j.dump()));
+  j = p.toJson();
+  j["denoise_direct_iterations"][1] = 0;
+  EXPECT_TRUE(refused(j.dump()));
+  j = p.toJson();
+  j["denoise_direct_iterations"].erase(1);
+  EXPECT_TRUE(refused(j.dump()));
+  j = p.toJson();
+  j["denoise_iterations"] = {0, 2, 2, 4, 5};
+  j["denoise_direct_iterations"] = {0, 2, 1, 2, 5};  // the third step costs less than the second
+  EXPECT_TRUE(refused(j.dump()));
+  j = p.toJson();
+  j["cost"]["photon_map_pass_share"] = 1.5;
+  EXPECT_TRUE(refused(j.dump()));
+  // A profile from before the direct passes: every pass filters both signals.
+  j = p.toJson();
+  j["denoise_iterations"] = {0, 2, 4};
+  j["error"]["denoise"] = {0.0, -0.005, -0.007};
+  j.erase("denoise_direct_iterations");
+  std::ofstream(path) << j.dump();
+  const ControlProfile old = ControlProfile::load(path, {"rest", "floor"});
+  EXPECT_EQ(old.denoiseDirectIterations, old.denoiseIterations);
+  EXPECT_DOUBLE_EQ(old.denoisePasses(2), 4.0);
   EXPECT_THROW(BudgetController(twoGroups(), paramsFor(-1.0), RenderOptions(), &kMask), Error);
   EXPECT_THROW(BudgetController(twoGroups(), paramsFor(std::nan("")), RenderOptions(), &kMask), Error);
 }

@@ -85,7 +85,7 @@ ControlProfile ControlProfile::generic(const std::vector<std::string>& groups) {
   const double top = double(p.photonSides.back()) * p.photonSides.back();
   for (uint32_t side : p.photonSides) p.photonError.push_back(0.01 * (top / (double(side) * side) - 1.0));
   for (float s : p.radiusScales) p.radiusError.push_back(0.01 * (1.0 / (s * s) - 1.0) + 0.01 * (s * s - 1.0));
-  p.denoiseError = {0.0, -0.005, -0.007};
+  p.denoiseError = {0.0, -0.005, -0.0065, -0.007, -0.0072};
   const double share = 1.0 / double(p.groups.size());
   for (size_t g = 0; g < p.groups.size(); ++g) {
     p.levelError.push_back({0.3 * share, 0.1 * share, 0.08 * share, 0.0});
@@ -105,10 +105,18 @@ void ControlProfile::validate() const {
       throw Error("photon sides must rise, each within 16..8192");
   for (float s : radiusScales)
     if (!(s > 0.05f && s < 20.0f)) throw Error("radius scales must be within 0.05..20");
-  for (size_t i = 0; i < denoiseIterations.size(); ++i)
-    if (denoiseIterations[i] < 0 || denoiseIterations[i] > kMaxDenoiseIterations ||
-        (i && denoiseIterations[i] <= denoiseIterations[i - 1]))
-      throw Error("denoise iterations must rise, each within 0.." + std::to_string(kMaxDenoiseIterations));
+  if (!(photonMapPassShare > 0.0 && photonMapPassShare <= 1.0))
+    throw Error("the photon-map pass share must be within (0, 1]");
+  if (denoiseDirectIterations.size() != denoiseIterations.size())
+    throw Error("the denoise ladder needs one direct iteration count per step");
+  for (size_t i = 0; i < denoiseIterations.size(); ++i) {
+    const int n = denoiseIterations[i], direct = denoiseDirectIterations[i];
+    if (n < 0 || n > kMaxDenoiseIterations)
+      throw Error("denoise iterations must be within 0.." + std::to_string(kMaxDenoiseIterations));
+    if (n == 0 ? direct != 0 : direct < 1 || direct > n)
+      throw Error("denoise direct iterations must be within 1..the step's iterations (0 where the denoiser is off)");
+    if (i && !(denoisePasses(int(i)) > denoisePasses(int(i) - 1))) throw Error("the denoise ladder's steps must rise in cost");
+  }
   if (photonError.size() != photonSides.size() || radiusError.size() != radiusScales.size() ||
       denoiseError.size() != denoiseIterations.size())
     throw Error("each ladder needs one error per step");
@@ -133,6 +141,11 @@ void ControlProfile::validate() const {
   }
 }
 
+double ControlProfile::denoisePasses(int step) const {
+  const int n = denoiseIterations[size_t(step)], direct = denoiseDirectIterations[size_t(step)];
+  return double(direct) + photonMapPassShare * double(n - direct);
+}
+
 ControlProfile ControlProfile::load(const std::string& path, const std::vector<std::string>& sceneGroups) {
   std::ifstream in(path);
   if (!in) throw Error("cannot open controller profile '" + path + "': no such file or not readable");
@@ -145,6 +158,8 @@ ControlProfile ControlProfile::load(const std::string& path, const std::vector<s
     p.photonSides = readList(j, "photon_sides", p.photonSides);
     p.radiusScales = readList(j, "radius_scales", p.radiusScales);
     p.denoiseIterations = readList(j, "denoise_iterations", p.denoiseIterations);
+    // Profiles from before the direct passes: every pass filters both signals.
+    p.denoiseDirectIterations = readList(j, "denoise_direct_iterations", p.denoiseIterations);
     const nlohmann::json& err = j.at("error");
     const nlohmann::json& cost = j.at("cost");
     p.topError = err.at("top").get<double>();
@@ -154,6 +169,7 @@ ControlProfile ControlProfile::load(const std::string& path, const std::vector<s
     p.foveatedError = err.at("foveated").get<double>();
     p.foveatedSamples = cost.at("foveated_samples").get<double>();
     p.denoiseMsPerIteration = cost.value("denoise_ms_per_iteration", p.denoiseMsPerIteration);
+    p.photonMapPassShare = cost.value("photon_map_pass_share", p.photonMapPassShare);
     p.photonFixedShare = cost.value("photon_fixed_share", p.photonFixedShare);
     p.densityFixedShare = cost.value("density_fixed_share", p.densityFixedShare);
     p.groups = sceneGroups;
@@ -185,10 +201,12 @@ nlohmann::json ControlProfile::toJson() const {
           {"photon_sides", photonSides},
           {"radius_scales", radiusScales},
           {"denoise_iterations", denoiseIterations},
+          {"denoise_direct_iterations", denoiseDirectIterations},
           {"error", {{"top", topError}, {"photons", photonError}, {"radius", radiusError}, {"denoise", denoiseError},
                      {"foveated", foveatedError}, {"groups", errGroups}}},
           {"cost", {{"groups", costGroups}, {"density_share", shares}, {"foveated_samples", foveatedSamples},
-                    {"denoise_ms_per_iteration", denoiseMsPerIteration}, {"photon_fixed_share", photonFixedShare},
+                    {"denoise_ms_per_iteration", denoiseMsPerIteration}, {"photon_map_pass_share", photonMapPassShare},
+                    {"photon_fixed_share", photonFixedShare},
                     {"density_fixed_share", densityFixedShare}}}};
 }
 
@@ -263,7 +281,7 @@ ControlCosts BudgetController::scaleOf(const ControlSetting& s) const {
   scale.photonMs = hasGi(s) ? fp + (1.0 - fp) * photons : 0.0;
   scale.densityMs = fd + (1.0 - fd) * photons * r * r * std::max(giShare, hasGi(s) ? kMinShare : 0.0) * samples;
   scale.rayMs = std::max(rays, kMinShare) * samples;
-  scale.denoiseMs = profile_.denoiseIterations[size_t(s.denoise)];
+  scale.denoiseMs = profile_.denoisePasses(s.denoise);
   scale.restMs = 1.0;
   return scale;
 }
@@ -303,7 +321,10 @@ RenderOptions BudgetController::optionsFor(const ControlSetting& s) const {
   o.gather.density.radius = base_.gather.density.radius * profile_.radiusScales[size_t(s.radius)];
   const int iterations = profile_.denoiseIterations[size_t(s.denoise)];
   o.denoise.enabled = iterations > 0;
-  if (iterations > 0) o.denoise.params.iterations = iterations;
+  if (iterations > 0) {
+    o.denoise.params.iterations = iterations;
+    o.denoise.params.directIterations = profile_.denoiseDirectIterations[size_t(s.denoise)];
+  }
   o.foveation.mask = s.foveated ? mask_ : nullptr;
   o.gather.overrideEffects = false;
   for (int g = 0; g < groups_; ++g) o.gather.groupEffects[g] = s.levels[size_t(g)];
@@ -483,6 +504,7 @@ nlohmann::json BudgetController::toJson(const ControlSetting& s, const ControlPr
   return {{"photons", profile.photonSides[size_t(s.photons)]},
           {"radius_scale", profile.radiusScales[size_t(s.radius)]},
           {"denoise_iterations", profile.denoiseIterations[size_t(s.denoise)]},
+          {"denoise_direct_iterations", profile.denoiseDirectIterations[size_t(s.denoise)]},
           {"foveated", s.foveated},
           {"levels", levels}};
 }

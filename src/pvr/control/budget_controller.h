@@ -7,7 +7,8 @@
 // Cost model: every frame's measured stage times are divided by how that stage scales with the
 // frame's setting (photon trace and map build ~ photons; density ~ photons x radius^2, the photons
 // a query meets, x the share of the gather points at level gi x the shaded samples; eye rays ~ the
-// groups' level costs x the shaded samples; denoising ~ iterations; the rest is constant), which
+// groups' level costs x the shaded samples; denoising ~ a-trous passes, a pass over the photon map
+// alone counted at photonMapPassShare; the rest is constant), which
 // leaves unit costs that depend on the view only. A candidate's time is the largest unit costs of
 // the last few frames times its scales: the view's cost is tracked as it changes, settings are
 // compared on equal terms.
@@ -39,7 +40,7 @@ constexpr int kControlledLevels = 4;  // raster, shadows, reflections, gi
 struct ControlSetting {
   int photons = 0;      ///< ControlProfile::photonSides
   int radius = 0;       ///< ControlProfile::radiusScales
-  int denoise = 0;      ///< ControlProfile::denoiseIterations (0 iterations: off)
+  int denoise = 0;      ///< ControlProfile::denoiseIterations and denoiseDirectIterations (0 iterations: off)
   bool foveated = false;
   std::array<uint8_t, kMaxEffectGroups> levels{};  ///< per effect group, an EffectLevel below Path
   bool operator==(const ControlSetting&) const = default;
@@ -51,7 +52,10 @@ struct ControlProfile {
   std::vector<std::string> groups{"rest"};  ///< the scene's effect groups, group 0 first
   std::vector<uint32_t> photonSides{128, 181, 256, 362, 512, 724, 1024};  ///< emitted photons = side^2
   std::vector<float> radiusScales{0.7f, 1.0f, 1.4f};  ///< times the radius the options ask for
-  std::vector<int> denoiseIterations{0, 2, 4};
+  // The denoiser's ladder: a-trous passes, and of them the direct signal's (its noise is finer than
+  // the photon map's: fewer passes cost less at about the same error, docs/benchmarks.md).
+  std::vector<int> denoiseIterations{0, 2, 4, 5, 5};
+  std::vector<int> denoiseDirectIterations{0, 2, 2, 2, 5};
   // Quality: relMSE of the best setting, and what each knob's step adds to it (may be negative:
   // the denoiser lowers the error).
   double topError = 0.02;
@@ -69,6 +73,11 @@ struct ControlProfile {
   // the photons, not proportional (on the H200's Sponza 128^2 photons took 0.66 ms, 724^2 3.8 ms).
   double photonFixedShare = 0.1, densityFixedShare = 0.1;
   double denoiseMsPerIteration = 0.2;  ///< until a denoised frame has been measured
+  // A pass over the photon-map signal alone, over a pass over both signals (ncu on the H100's
+  // Sponza walk: 0.78).
+  double photonMapPassShare = 0.78;
+  // A denoise step's cost in passes over both signals (the denoise cost's scale).
+  double denoisePasses(int step) const;
 
   // The generic model for a scene with these groups: variance ~ 1 / (photons x radius^2), bias ~
   // radius^2, each group's levels by its share, the foveated frame 4x cheaper.
