@@ -97,7 +97,10 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                  {.name = "denoise, direct 2 passes", .denoise = true, .taa = false, .photonBatches = 1,
                                   .directIterations = 2},
                                  {.name = "denoise, direct 2 passes, gather reuse", .denoise = true, .taa = false,
-                                  .photonBatches = 1, .stereo = StereoMode::Gather, .directIterations = 2}};
+                                  .photonBatches = 1, .stereo = StereoMode::Gather, .directIterations = 2},
+                                 // The cheapest of the controller's denoise steps above 2 passes, under reuse.
+                                 {.name = "denoise, 4 passes, direct 2, gather reuse", .denoise = true, .taa = false,
+                                  .photonBatches = 1, .stereo = StereoMode::Gather, .iterations = 4, .directIterations = 2}};
 
 // The variants the run asked for (--quality-variants; all where empty), each checked: the first,
 // "raw", is every ratio's base and always runs.
