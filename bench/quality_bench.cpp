@@ -104,6 +104,48 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
 
 // The variants the run asked for (--quality-variants; all where empty), each checked: the first,
 // "raw", is every ratio's base and always runs.
+// The image a variant's eyes are shown (the last stage it runs).
+EyeImage shownImage(const Variant& v) {
+  return v.taa ? EyeImage::Displayed : v.denoise ? EyeImage::Denoised : EyeImage::Rendered;
+}
+
+// Where the first frame with non-finite pixels has them: per eye, how many, the first such
+// pixel, what the eye pass rendered there and (for the right eye under reuse) the left pixel it
+// reused, and how many of them the eye pass already rendered non-finite (else the denoiser made them).
+std::string describeNonFinite(FrameRenderer& renderer, EyeImage displayed, bool reusing, const uint64_t counts[2]) {
+  std::string out;
+  for (Eye eye : {Eye::Left, Eye::Right}) {
+    const int e = int(eye);
+    EyeResult shown, rendered;
+    EyeReadback what;
+    what.image = displayed;
+    what.reusedFrom = reusing && eye == Eye::Right;
+    renderer.backend().readEye(eye, what, shown);
+    what.image = EyeImage::Rendered;
+    renderer.backend().readEye(eye, what, rendered);
+    char line[400];
+    std::snprintf(line, sizeof line, "%seye %d: %llu pixels", e ? "; " : "", e, (unsigned long long)counts[e]);
+    out += line;
+    size_t first = shown.image.pixels.size(), renderedBad = 0;
+    for (size_t i = 0; i < shown.image.pixels.size(); ++i) {
+      if (isFinite(shown.image.pixels[i])) continue;
+      if (first == shown.image.pixels.size()) first = i;
+      if (i < rendered.image.pixels.size() && !isFinite(rendered.image.pixels[i])) ++renderedBad;
+    }
+    if (first == shown.image.pixels.size()) continue;
+    const Vec3 c = shown.image.pixels[first], r = rendered.image.pixels[first];
+    const uint32_t source = shown.reusedFrom && first < shown.reusedFrom->size() ? (*shown.reusedFrom)[first] : kNotReused;
+    std::snprintf(line, sizeof line,
+                  " (%zu rendered non-finite), the first at (%zu, %zu): shown (%g, %g, %g), rendered (%g, %g, %g), inverse "
+                  "depth %g, %s",
+                  renderedBad, first % size_t(shown.image.width), first / size_t(shown.image.width), c.x, c.y, c.z, r.x, r.y,
+                  r.z, first < shown.inverseDepth.size() ? shown.inverseDepth[first] : -1.0f,
+                  source == kNotReused ? "shaded by its eye" : ("reused left pixel " + std::to_string(source)).c_str());
+    out += line;
+  }
+  return out;
+}
+
 std::vector<const Variant*> selectedVariants(const std::string& names) {
   const std::vector<std::string> asked = names.empty() ? std::vector<std::string>() : splitList(names, ';');
   for (const std::string& name : asked)
@@ -359,6 +401,8 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       size_t nonFinite[3] = {0, 0, 0};  // pixels of both eyes at each compared frame
       Image last, stillShown;
       std::vector<double> changes;  // after the still frames, moving: frame-to-frame change of the left eye
+      DeviceImageCheck deviceCheck;  // on the GPU every still frame is checked there
+      int firstNonFinite = -1;
       for (int f = 0; f < kStillFrames + kAfterStill; ++f) {
         if (f >= kStillFrames) {
           StereoRig rig = start;
@@ -370,6 +414,13 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
         }
         const int slot = f == 0 ? 0 : f == kHz - 1 ? 1 : f == kStillFrames - 1 ? 2 : -1;
         FrameResult r = renderer->render(start, vo, slot >= 0);
+        uint64_t counts[2];
+        deviceCheck.nonFinitePixels(*renderer, size_t(start.width) * size_t(start.height), counts);
+        if ((counts[0] || counts[1]) && firstNonFinite < 0) {
+          firstNonFinite = f;
+          std::printf("| %s | %s | first non-finite pixels at still frame %d (still %d): %s |\n", scene.name.c_str(), v.name,
+                      f, renderer->stillFrames(), describeNonFinite(*renderer, shownImage(v), v.stereo != StereoMode::Separate, counts).c_str());
+        }
         if (slot < 0) continue;
         for (int e = 0; e < 2; ++e) nonFinite[slot] += nonFinitePixels(r.eyes[e].image);
         ReferenceError e[2] = {compareToReference(r.eyes[0].image, still[0]), compareToReference(r.eyes[1].image, still[1])};
@@ -386,7 +437,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
       const double median = settled.empty() ? 0.0 : settled[settled.size() / 2];
       const double pop = median > 0 ? *std::max_element(changes.begin(), changes.begin() + 10) / median : 0.0;
       const size_t anyNonFinite = nonFinite[0] + nonFinite[1] + nonFinite[2];
-      const bool ok = at[2].relMse < 1.0 && (!v.denoise || at[2].relMse < at[0].relMse) && anyNonFinite == 0;
+      const bool ok = at[2].relMse < 1.0 && (!v.denoise || at[2].relMse < at[0].relMse) && anyNonFinite == 0 && firstNonFinite < 0;
       if (anyNonFinite)
         std::printf("| %s | %s | non-finite pixels (both eyes) at frame 1, after 1 s, after 5 s: %zu, %zu, %zu |\n",
                     scene.name.c_str(), v.name, nonFinite[0], nonFinite[1], nonFinite[2]);

@@ -408,7 +408,7 @@ TEST(GpuBackend, DenoisingMatchesTheCpu) {
 // Fills most free device memory with all-ones bytes (NaN as floats) and frees it: a renderer made
 // next gets memory that earlier work left dirty, as in the benches (a fresh process's is zeros),
 // so that a read of memory nothing wrote shows up.
-void dirtyFreeDeviceMemory() {
+void dirtyFreeDeviceMemory(int byte) {
   size_t free = 0, total = 0;
   ASSERT_EQ(cudaMemGetInfo(&free, &total), cudaSuccess);
   std::vector<void*> chunks;
@@ -416,7 +416,7 @@ void dirtyFreeDeviceMemory() {
   for (size_t held = 0; held + 2 * chunk < free; held += chunk) {
     void* p = nullptr;
     if (cudaMalloc(&p, chunk) != cudaSuccess) break;
-    ASSERT_EQ(cudaMemset(p, 0xff, chunk), cudaSuccess);
+    ASSERT_EQ(cudaMemset(p, byte, chunk), cudaSuccess);
     chunks.push_back(p);
   }
   ASSERT_EQ(cudaDeviceSynchronize(), cudaSuccess);
@@ -427,9 +427,11 @@ void dirtyFreeDeviceMemory() {
 // A still head refining for 5 s (450 frames) at the quality bench's settings on Dabrovic Sponza,
 // both eyes at full resolution, the right eye under gather reuse (its history refers to the left
 // eye's where it reused pixels), in memory left dirty, images left on the GPU as the bench leaves
-// them: no pixel of any frame is non-finite (counted on the GPU every frame). (The quality bench
-// found non-finite pixels there after 5 s on the H100, 2026-12-06; a first version of this test,
-// in fresh memory with every frame read back, did not.) Needs PVR_SCENES (skipped without).
+// them: no pixel of any frame is non-finite (counted on the GPU every frame); separate eyes too.
+// A failure names the frame, each eye's count, how many the eye pass itself rendered non-finite
+// (else the denoiser made them) and the first such pixel. It FAILS on 2026-12-06's code (H100 and
+// H200): the right eye's eye pass renders 20-30 non-finite pixels on some frames under gather
+// (docs/reliability.md). Needs PVR_SCENES (skipped without).
 TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
   PVR_REQUIRE_GPU();
   if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
@@ -440,8 +442,11 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
     GTEST_SKIP() << e.what();
   }
   const size_t pixels = size_t(scene.rig.width) * size_t(scene.rig.height);
-  for (StereoMode stereo : {StereoMode::Gather, StereoMode::Separate}) {
-    dirtyFreeDeviceMemory();
+  // Memory full of NaN (0xff bytes) fails every test a read of it meets; memory full of 0.747
+  // (0x3f bytes) passes them, as the finite leftovers of earlier renderers do in the bench.
+  const std::pair<StereoMode, int> runs[] = {{StereoMode::Separate, 0xff}, {StereoMode::Gather, 0xff}, {StereoMode::Gather, 0x3f}};
+  for (const auto& [stereo, fill] : runs) {
+    dirtyFreeDeviceMemory(fill);
     FrameRenderer gpu = makeCudaFrameRenderer(scene);
     RenderOptions o;
     o.photonsX = o.photonsY = 512;
@@ -456,24 +461,57 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
       uint64_t counts[2] = {0, 0};
       counter.count(images, pixels, gpu.deviceStream(), counts);
       if (!counts[0] && !counts[1]) continue;
-      // Where: the first such pixel of each eye, and its depth.
-      std::string where = std::string(stereo == StereoMode::Gather ? "gather" : "separate") + ", frame " +
+      // Where: the first such pixel of each eye, what the eye pass rendered there (non-finite
+      // already: the eye pass; finite: the denoiser), and for a reused right pixel the left's.
+      std::string where = std::string(stereo == StereoMode::Gather ? "gather" : "separate") + ", memory filled with " +
+                          std::to_string(fill) + ", frame " +
                           std::to_string(f) + " (still " + std::to_string(gpu.stillFrames()) + ")";
+      EyeResult shown[2], rendered[2];
       for (int e = 0; e < 2; ++e) {
-        std::vector<Vec3> image(pixels);
-        std::vector<float> inverseDepth(pixels);
-        ASSERT_EQ(cudaMemcpy(image.data(), images[e], pixels * sizeof(Vec3), cudaMemcpyDeviceToHost), cudaSuccess);
-        ASSERT_EQ(cudaMemcpy(inverseDepth.data(), gpu.deviceInverseDepth(Eye(e)), pixels * sizeof(float),
-                             cudaMemcpyDeviceToHost),
-                  cudaSuccess);
+        EyeReadback what;
+        what.image = EyeImage::Denoised;  // (no TAA here: nothing displayed apart)
+        what.reusedFrom = e == 1 && stereo == StereoMode::Gather;
+        gpu.backend().readEye(Eye(e), what, shown[e]);
+        what.image = EyeImage::Rendered;
+        gpu.backend().readEye(Eye(e), what, rendered[e]);
+      }
+      auto describe = [](const Vec3& c) {
+        return "(" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) + ")";
+      };
+      for (int e = 0; e < 2; ++e) {
+        const std::vector<Vec3>& image = shown[e].image.pixels;
+        const size_t renderedBad = size_t(std::count_if(rendered[e].image.pixels.begin(), rendered[e].image.pixels.end(),
+                                                        [](const Vec3& c) { return !isFinite(c); }));
         const auto bad = std::find_if(image.begin(), image.end(), [](const Vec3& c) { return !isFinite(c); });
-        where += "; eye " + std::to_string(e) + ": " + std::to_string(counts[e]) + " pixels";
+        where += "; eye " + std::to_string(e) + ": " + std::to_string(counts[e]) + " pixels (rendered non-finite: " +
+                 std::to_string(renderedBad) + ")";
+        // The rendered ones: reused or shaded by the eye, and the first with its depth.
+        size_t renderedReused = 0, firstRendered = pixels;
+        for (size_t i = 0; i < pixels; ++i) {
+          if (isFinite(rendered[e].image.pixels[i])) continue;
+          if (firstRendered == pixels) firstRendered = i;
+          renderedReused += shown[e].reusedFrom && (*shown[e].reusedFrom)[i] != kNotReused;
+        }
+        if (firstRendered < pixels)
+          where += " [rendered: " + std::to_string(renderedReused) + " reused; the first at (" +
+                   std::to_string(firstRendered % size_t(scene.rig.width)) + ", " +
+                   std::to_string(firstRendered / size_t(scene.rig.width)) + "), inverse depth " +
+                   std::to_string(rendered[e].inverseDepth[firstRendered]) + ", " +
+                   describe(rendered[e].image.pixels[firstRendered]) + "]";
         if (bad == image.end()) continue;
         const size_t i = size_t(bad - image.begin());
         where += ", the first at (" + std::to_string(i % size_t(scene.rig.width)) + ", " +
-                 std::to_string(i / size_t(scene.rig.width)) + "), inverse depth " + std::to_string(inverseDepth[i]);
+                 std::to_string(i / size_t(scene.rig.width)) + "), inverse depth " + std::to_string(shown[e].inverseDepth[i]) +
+                 ", rendered " + describe(rendered[e].image.pixels[i]);
+        const uint32_t source = shown[e].reusedFrom ? (*shown[e].reusedFrom)[i] : kNotReused;
+        if (source != kNotReused)
+          where += ", reused left pixel " + std::to_string(source) + " (left shown " + describe(shown[0].image.pixels[source]) +
+                   ", rendered " + describe(rendered[0].image.pixels[source]) + ")";
+        else if (shown[e].reusedFrom)
+          where += ", shaded by the right eye";
       }
-      FAIL() << where;
+      ADD_FAILURE() << where;
+      break;  // the next run
     }
   }
 }

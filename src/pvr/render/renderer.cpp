@@ -63,13 +63,18 @@ DeviceImageCheck::DeviceImageCheck() : impl_(std::make_unique<Impl>()) {}
 DeviceImageCheck::~DeviceImageCheck() = default;
 
 void DeviceImageCheck::nonFinitePixels(const Renderer& renderer, uint64_t counts[2]) {
+  nonFinitePixels(renderer.frameRenderer(), size_t(renderer.rig().width) * size_t(renderer.rig().height),
+                  counts);
+}
+
+void DeviceImageCheck::nonFinitePixels(const FrameRenderer& frames, size_t pixels, uint64_t counts[2]) {
   counts[0] = counts[1] = 0;
 #ifdef PVR_HAVE_CUDA
-  const Vec3* images[2] = {renderer.deviceImage(Eye::Left), renderer.deviceImage(Eye::Right)};
+  const Vec3* images[2] = {frames.deviceImage(Eye::Left), frames.deviceImage(Eye::Right)};
   if (!images[0] && !images[1]) return;
-  impl_->counter.count(images, size_t(renderer.rig().width) * size_t(renderer.rig().height), renderer.deviceStream(), counts);
+  impl_->counter.count(images, pixels, frames.deviceStream(), counts);
 #else
-  (void)renderer;
+  (void)frames, (void)pixels;
 #endif
 }
 

@@ -59,6 +59,7 @@ class Renderer {
   std::string backendName() const { return frames_.name(); }
   std::string deviceName() const { return frames_.deviceName(); }
   FrameRenderer& frameRenderer() { return frames_; }
+  const FrameRenderer& frameRenderer() const { return frames_; }
 
  private:
   StereoRig rig_;
@@ -77,6 +78,8 @@ class DeviceImageCheck {
   DeviceImageCheck& operator=(const DeviceImageCheck&) = delete;
   // Per eye; 0 for an eye with no image in GPU memory (the CPU backend, an eye not rendered).
   void nonFinitePixels(const Renderer& renderer, uint64_t counts[2]);
+  // The same for a frame renderer's last frame, its eyes `pixels` each.
+  void nonFinitePixels(const FrameRenderer& frames, size_t pixels, uint64_t counts[2]);
 
  private:
   struct Impl;

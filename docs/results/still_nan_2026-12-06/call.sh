@@ -10,6 +10,11 @@ for phase in "$@"; do
   case $phase in
   nantest)
     step nan_test 150 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=*ARefiningStillHead* ;;
+  nan2)
+    step nan_twice 100 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=*ARefiningStillHead* --gtest_repeat=2 ;;
+  nanrepeat)
+    step nan_repeat 120 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=*ARefiningStillHead* --gtest_repeat=3
+    step nan_blocking 120 env CUDA_LAUNCH_BLOCKING=1 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=*ARefiningStillHead* --gtest_repeat=3 ;;
   tests)
     step gpu_tests 200 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=-*ARefiningStillHead* ;;
   accumulate)
@@ -19,6 +24,6 @@ for phase in "$@"; do
   scenes)
     step scenes $((590 - SECONDS)) stdbuf -oL .gpu/run.sh .gpu/bin/photonvr bench --suite scenes --backend cuda --frames 300 --warmup 30 --scene-radius 0.15 --json $results/scenes.json ;;
   quality_still)
-    step quality_still $((590 - SECONDS)) stdbuf -oL .gpu/run.sh .gpu/bin/photonvr bench --suite quality --backend cuda --quality-scenes scenes/dabrovic-sponza.json --quality-variants "denoise, gather reuse" --json $results/quality_still.json ;;
+    step quality_still $((560 - SECONDS)) stdbuf -oL .gpu/run.sh .gpu/bin/photonvr bench --suite quality --backend cuda --quality-scenes scenes/dabrovic-sponza.json --quality-variants "denoise, gather reuse" --json $results/quality_still.json ;;
   esac
 done
