@@ -444,8 +444,18 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
   const size_t pixels = size_t(scene.rig.width) * size_t(scene.rig.height);
   // Memory full of NaN (0xff bytes) fails every test a read of it meets; memory full of 0.747
   // (0x3f bytes) passes them, as the finite leftovers of earlier renderers do in the bench.
-  const std::pair<StereoMode, int> runs[] = {{StereoMode::Separate, 0xff}, {StereoMode::Gather, 0xff}, {StereoMode::Gather, 0x3f}};
-  for (const auto& [stereo, fill] : runs) {
+  // The ray schedules tell the eye passes' paths apart: on Sponza (3 shadow queries a point) Auto
+  // defers the shadow rays of separate eyes and of the left eye under gather, and gives the
+  // reusing right eye its first hits apart and a listed pass over the pixels it does not reuse.
+  struct Run {
+    StereoMode stereo;
+    RaySchedule schedule;
+    int fill;
+  };
+  const Run runs[] = {{StereoMode::Separate, RaySchedule::Auto, 0xff},      {StereoMode::Gather, RaySchedule::Auto, 0xff},
+                      {StereoMode::Gather, RaySchedule::Auto, 0x3f},        {StereoMode::Separate, RaySchedule::FirstHits, 0xff},
+                      {StereoMode::Gather, RaySchedule::InKernel, 0xff},    {StereoMode::Gather, RaySchedule::Deferred, 0xff}};
+  for (const auto& [stereo, schedule, fill] : runs) {
     dirtyFreeDeviceMemory(fill);
     FrameRenderer gpu = makeCudaFrameRenderer(scene);
     RenderOptions o;
@@ -454,6 +464,7 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
     o.gather.mode = ShadingMode::Full;
     o.denoise.enabled = true;
     o.stereo = stereo;
+    o.raySchedule = schedule;
     cuda::NonFiniteCounter counter;
     for (int f = 0; f < 460; ++f) {
       gpu.render(scene.rig, o, false);
@@ -463,7 +474,8 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
       if (!counts[0] && !counts[1]) continue;
       // Where: the first such pixel of each eye, what the eye pass rendered there (non-finite
       // already: the eye pass; finite: the denoiser), and for a reused right pixel the left's.
-      std::string where = std::string(stereo == StereoMode::Gather ? "gather" : "separate") + ", memory filled with " +
+      std::string where = std::string(stereo == StereoMode::Gather ? "gather" : "separate") + ", ray schedule " +
+                          rayScheduleName(schedule) + ", memory filled with " +
                           std::to_string(fill) + ", frame " +
                           std::to_string(f) + " (still " + std::to_string(gpu.stillFrames()) + ")";
       EyeResult shown[2], rendered[2];
