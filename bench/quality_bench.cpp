@@ -109,37 +109,43 @@ EyeImage shownImage(const Variant& v) {
   return v.taa ? EyeImage::Displayed : v.denoise ? EyeImage::Denoised : EyeImage::Rendered;
 }
 
-// Where the first frame with non-finite pixels has them: per eye, how many, the first such
-// pixel, what the eye pass rendered there and (for the right eye under reuse) the left pixel it
-// reused, and how many of them the eye pass already rendered non-finite (else the denoiser made them).
-std::string describeNonFinite(FrameRenderer& renderer, EyeImage displayed, bool reusing, const uint64_t counts[2]) {
+// Where the first frame with non-finite pixels has them, per eye: how many the eye shows and how
+// many its eye pass rendered, of those how many the right eye reused, and the first rendered one
+// (its value, depth and the left pixel it reused) or else the first shown one.
+std::string describeNonFinite(FrameRenderer& renderer, EyeImage displayed, bool reusing) {
   std::string out;
   for (Eye eye : {Eye::Left, Eye::Right}) {
     const int e = int(eye);
     EyeResult shown, rendered;
     EyeReadback what;
     what.image = displayed;
-    what.reusedFrom = reusing && eye == Eye::Right;
     renderer.backend().readEye(eye, what, shown);
     what.image = EyeImage::Rendered;
+    what.reusedFrom = reusing && eye == Eye::Right;
     renderer.backend().readEye(eye, what, rendered);
-    char line[400];
-    std::snprintf(line, sizeof line, "%seye %d: %llu pixels", e ? "; " : "", e, (unsigned long long)counts[e]);
-    out += line;
-    size_t first = shown.image.pixels.size(), renderedBad = 0;
-    for (size_t i = 0; i < shown.image.pixels.size(); ++i) {
-      if (isFinite(shown.image.pixels[i])) continue;
-      if (first == shown.image.pixels.size()) first = i;
-      if (i < rendered.image.pixels.size() && !isFinite(rendered.image.pixels[i])) ++renderedBad;
+    const size_t n = rendered.image.pixels.size();
+    size_t shownBad = 0, renderedBad = 0, reusedBad = 0, first = n;
+    for (size_t i = 0; i < n; ++i) {
+      shownBad += !isFinite(shown.image.pixels[i]);
+      if (isFinite(rendered.image.pixels[i])) continue;
+      ++renderedBad;
+      reusedBad += rendered.reusedFrom && (*rendered.reusedFrom)[i] != kNotReused;
+      if (first == n) first = i;
     }
-    if (first == shown.image.pixels.size()) continue;
-    const Vec3 c = shown.image.pixels[first], r = rendered.image.pixels[first];
-    const uint32_t source = shown.reusedFrom && first < shown.reusedFrom->size() ? (*shown.reusedFrom)[first] : kNotReused;
-    std::snprintf(line, sizeof line,
-                  " (%zu rendered non-finite), the first at (%zu, %zu): shown (%g, %g, %g), rendered (%g, %g, %g), inverse "
-                  "depth %g, %s",
-                  renderedBad, first % size_t(shown.image.width), first / size_t(shown.image.width), c.x, c.y, c.z, r.x, r.y,
-                  r.z, first < shown.inverseDepth.size() ? shown.inverseDepth[first] : -1.0f,
+    const std::vector<Vec3>& image = first < n ? rendered.image.pixels : shown.image.pixels;
+    if (first == n)
+      for (size_t i = 0; i < n && first == n; ++i)
+        if (!isFinite(shown.image.pixels[i])) first = i;
+    char line[480];
+    std::snprintf(line, sizeof line, "%seye %d: %zu shown, %zu rendered (%zu reused)", e ? "; " : "", e, shownBad,
+                  renderedBad, reusedBad);
+    out += line;
+    if (first == n) continue;
+    const Vec3 c = image[first];
+    const uint32_t source = rendered.reusedFrom ? (*rendered.reusedFrom)[first] : kNotReused;
+    std::snprintf(line, sizeof line, ", the first %s at (%zu, %zu): (%g, %g, %g), inverse depth %g, %s",
+                  renderedBad ? "rendered" : "shown", first % size_t(rendered.image.width), first / size_t(rendered.image.width),
+                  c.x, c.y, c.z, rendered.inverseDepth[first],
                   source == kNotReused ? "shaded by its eye" : ("reused left pixel " + std::to_string(source)).c_str());
     out += line;
   }
@@ -414,12 +420,15 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
         }
         const int slot = f == 0 ? 0 : f == kHz - 1 ? 1 : f == kStillFrames - 1 ? 2 : -1;
         FrameResult r = renderer->render(start, vo, slot >= 0);
-        uint64_t counts[2];
-        deviceCheck.nonFinitePixels(*renderer, size_t(start.width) * size_t(start.height), counts);
-        if ((counts[0] || counts[1]) && firstNonFinite < 0) {
+        // Shown and as the eye pass rendered them (the denoiser counts a non-finite sample as black).
+        uint64_t counts[2], rendered[2];
+        const size_t pixels = size_t(start.width) * size_t(start.height);
+        deviceCheck.nonFinitePixels(*renderer, pixels, counts);
+        deviceCheck.nonFinitePixels(*renderer, pixels, EyeImage::Rendered, rendered);
+        if ((counts[0] || counts[1] || rendered[0] || rendered[1]) && firstNonFinite < 0) {
           firstNonFinite = f;
           std::printf("| %s | %s | first non-finite pixels at still frame %d (still %d): %s |\n", scene.name.c_str(), v.name,
-                      f, renderer->stillFrames(), describeNonFinite(*renderer, shownImage(v), v.stereo != StereoMode::Separate, counts).c_str());
+                      f, renderer->stillFrames(), describeNonFinite(*renderer, shownImage(v), v.stereo != StereoMode::Separate).c_str());
         }
         if (slot < 0) continue;
         for (int e = 0; e < 2; ++e) nonFinite[slot] += nonFinitePixels(r.eyes[e].image);

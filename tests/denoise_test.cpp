@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "pvr/cpu/cpu_frame_backend.h"
@@ -452,6 +453,37 @@ TEST(Denoise, NoPassReadsWhatNoFrameWrote) {
           ASSERT_TRUE(isFinite(c)) << "eye " << e << ", pixel " << i;
           ASSERT_EQ(c, out[0][e].pixels[i]) << "eye " << e << ", pixel " << i;
         }
+    }
+  }
+}
+
+// A non-finite sample (an eye pass's NaN or +Inf) counts as black: the frames come out as with
+// black there, every pixel finite, frame after frame (moving and then refining), instead of the
+// filter spreading it over its footprint and the history keeping it. Also a non-finite albedo
+// (demodulated by 1, as a black one).
+TEST(Denoise, NonFiniteSamplesCountAsBlack) {
+  const int w = 40, h = 32;
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  HostDenoiser poisoned, black;
+  for (int frame = 0; frame < 8; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    SyntheticFrame bad = noisyPlane(w, h, 90 + unsigned(frame)), good = bad;
+    const size_t a = bad.at(10, 10), b = bad.at(20, 12), c = bad.at(30, 20), d = bad.at(5 + frame, 25);
+    bad.image[a] = Vec3(inf, 0.5f, 0.5f);  // the photon-map signal infinite
+    good.image[a] = good.direct[a];
+    bad.direct[b] = Vec3(nan);  // both signals non-finite
+    good.direct[b] = Vec3(0.0f), good.image[b] = Vec3(0.0f);
+    bad.albedo[c] = Vec3(inf);
+    good.albedo[c] = Vec3(1.0f);
+    bad.image[d] = bad.direct[d] = Vec3(nan, inf, 1.0f);  // a different pixel each frame
+    good.image[d] = good.direct[d] = Vec3(0.0f);
+    const int still = frame < 4 ? 0 : frame - 3;
+    Image out, expected;
+    poisoned.denoise(Eye::Left, bad.camera, DenoiseParams(), bad.inputs(), out, still);
+    black.denoise(Eye::Left, good.camera, DenoiseParams(), good.inputs(), expected, still);
+    for (size_t i = 0; i < out.pixels.size(); ++i) {
+      ASSERT_TRUE(isFinite(out.pixels[i])) << "pixel " << i;
+      ASSERT_EQ(out.pixels[i], expected.pixels[i]) << "pixel " << i;
     }
   }
 }

@@ -469,9 +469,13 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
     for (int f = 0; f < 460; ++f) {
       gpu.render(scene.rig, o, false);
       const Vec3* images[2] = {gpu.deviceImage(Eye::Left), gpu.deviceImage(Eye::Right)};
-      uint64_t counts[2] = {0, 0};
+      uint64_t counts[2] = {0, 0}, renderedCounts[2] = {0, 0};
       counter.count(images, pixels, gpu.deviceStream(), counts);
-      if (!counts[0] && !counts[1]) continue;
+      // Also what the eye passes rendered: the denoiser counts a non-finite sample as black.
+      const Vec3* renderedImages[2] = {gpu.backend().deviceImage(Eye::Left, EyeImage::Rendered),
+                                       gpu.backend().deviceImage(Eye::Right, EyeImage::Rendered)};
+      counter.count(renderedImages, pixels, gpu.deviceStream(), renderedCounts);
+      if (!counts[0] && !counts[1] && !renderedCounts[0] && !renderedCounts[1]) continue;
       // Where: the first such pixel of each eye, what the eye pass rendered there (non-finite
       // already: the eye pass; finite: the denoiser), and for a reused right pixel the left's.
       std::string where = std::string(stereo == StereoMode::Gather ? "gather" : "separate") + ", ray schedule " +

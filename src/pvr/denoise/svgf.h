@@ -201,10 +201,11 @@ PVR_HOST_DEVICE inline int denoiseSpacing(const DenoiseFrameView& v, size_t pixe
   return s > 1.5f ? int(s + 0.5f) : 1;
 }
 
-// Divides by the albedo where it can be divided by (a black channel keeps its value).
+// Divides by the albedo where it can be divided by (a black or non-finite channel keeps its value).
 PVR_HOST_DEVICE inline Vec3 demodulationAlbedo(Vec3 a) {
-  const float kMin = 1e-3f;
-  return {a.x > kMin ? a.x : 1.0f, a.y > kMin ? a.y : 1.0f, a.z > kMin ? a.z : 1.0f};
+  const float kMin = 1e-3f, kMax = 1e30f;
+  auto channel = [&](float c) { return c > kMin && c < kMax ? c : 1.0f; };
+  return {channel(a.x), channel(a.y), channel(a.z)};
 }
 PVR_HOST_DEVICE inline Vec3 divide(Vec3 a, Vec3 b) { return {a.x / b.x, a.y / b.y, a.z / b.z}; }
 
@@ -334,6 +335,10 @@ PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t 
     signal[0] = divide(image, albedo);
     signal[1] = Vec3(0.0f);
   }
+  // A non-finite sample (NaN, or +Inf, which the clamps above keep) counts as black, as pbrt's film
+  // drops one: else the filter spreads it over its footprint and the history keeps it.
+  for (int s = 0; s < 2; ++s)
+    if (!isFinite(signal[s])) signal[s] = Vec3(0.0f);
   guide.normal = in.normal ? in.normal[pixel] : Vec3(0.0f);
   guide.inverseDepth = in.inverseDepth[pixel];
 }

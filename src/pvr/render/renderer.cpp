@@ -68,13 +68,24 @@ void DeviceImageCheck::nonFinitePixels(const Renderer& renderer, uint64_t counts
 }
 
 void DeviceImageCheck::nonFinitePixels(const FrameRenderer& frames, size_t pixels, uint64_t counts[2]) {
+  const Vec3* images[2] = {frames.deviceImage(Eye::Left), frames.deviceImage(Eye::Right)};
+  count(images, pixels, frames.deviceStream(), counts);
+}
+
+void DeviceImageCheck::nonFinitePixels(FrameRenderer& frames, size_t pixels, EyeImage which, uint64_t counts[2]) {
+  const bool rendered[2] = {frames.deviceImage(Eye::Left) != nullptr, frames.deviceImage(Eye::Right) != nullptr};
+  const Vec3* images[2] = {rendered[0] ? frames.backend().deviceImage(Eye::Left, which) : nullptr,
+                           rendered[1] ? frames.backend().deviceImage(Eye::Right, which) : nullptr};
+  count(images, pixels, frames.deviceStream(), counts);
+}
+
+void DeviceImageCheck::count(const Vec3* const images[2], size_t pixels, void* stream, uint64_t counts[2]) {
   counts[0] = counts[1] = 0;
 #ifdef PVR_HAVE_CUDA
-  const Vec3* images[2] = {frames.deviceImage(Eye::Left), frames.deviceImage(Eye::Right)};
   if (!images[0] && !images[1]) return;
-  impl_->counter.count(images, pixels, frames.deviceStream(), counts);
+  impl_->counter.count(images, pixels, stream, counts);
 #else
-  (void)frames, (void)pixels;
+  (void)images, (void)pixels, (void)stream;
 #endif
 }
 

@@ -78,10 +78,13 @@ class DeviceImageCheck {
   DeviceImageCheck& operator=(const DeviceImageCheck&) = delete;
   // Per eye; 0 for an eye with no image in GPU memory (the CPU backend, an eye not rendered).
   void nonFinitePixels(const Renderer& renderer, uint64_t counts[2]);
-  // The same for a frame renderer's last frame, its eyes `pixels` each.
+  // The same for a frame renderer's last frame, its eyes `pixels` each: the images shown, or
+  // another stage's (EyeImage::Rendered: what the eye pass made, before the denoiser and TAA).
   void nonFinitePixels(const FrameRenderer& frames, size_t pixels, uint64_t counts[2]);
+  void nonFinitePixels(FrameRenderer& frames, size_t pixels, EyeImage which, uint64_t counts[2]);
 
  private:
+  void count(const Vec3* const images[2], size_t pixels, void* stream, uint64_t counts[2]);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
