@@ -335,8 +335,9 @@ PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t 
     signal[0] = divide(image, albedo);
     signal[1] = Vec3(0.0f);
   }
-  // A non-finite sample (NaN, or +Inf, which the clamps above keep) counts as black, as pbrt's film
-  // drops one: else the filter spreads it over its footprint and the history keeps it.
+  // A sample still not finite here (+Inf passes the clamps above, as NaN does with one signal)
+  // counts as black, as pbrt's film drops one: else the filter spreads it over its footprint and a
+  // refining history keeps it.
   for (int s = 0; s < 2; ++s)
     if (!isFinite(signal[s])) signal[s] = Vec3(0.0f);
   guide.normal = in.normal ? in.normal[pixel] : Vec3(0.0f);
