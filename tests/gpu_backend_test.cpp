@@ -405,7 +405,7 @@ TEST(GpuBackend, DenoisingMatchesTheCpu) {
   }
 }
 
-// Fills most free device memory with all-ones bytes (NaN as floats) and frees it: a renderer made
+// Fills most free device memory with `byte` (0xff: NaN as floats) and frees it: a renderer made
 // next gets memory that earlier work left dirty, as in the benches (a fresh process's is zeros),
 // so that a read of memory nothing wrote shows up.
 void dirtyFreeDeviceMemory(int byte) {
@@ -496,18 +496,17 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
       };
       for (int e = 0; e < 2; ++e) {
         const std::vector<Vec3>& image = shown[e].image.pixels;
-        const size_t renderedBad = size_t(std::count_if(rendered[e].image.pixels.begin(), rendered[e].image.pixels.end(),
-                                                        [](const Vec3& c) { return !isFinite(c); }));
         const auto bad = std::find_if(image.begin(), image.end(), [](const Vec3& c) { return !isFinite(c); });
-        where += "; eye " + std::to_string(e) + ": " + std::to_string(counts[e]) + " pixels (rendered non-finite: " +
-                 std::to_string(renderedBad) + ")";
-        // The rendered ones: reused or shaded by the eye, and the first with its depth.
-        size_t renderedReused = 0, firstRendered = pixels;
+        // The rendered ones: how many, reused or shaded by the eye, and the first with its depth.
+        size_t renderedBad = 0, renderedReused = 0, firstRendered = pixels;
         for (size_t i = 0; i < pixels; ++i) {
           if (isFinite(rendered[e].image.pixels[i])) continue;
+          ++renderedBad;
           if (firstRendered == pixels) firstRendered = i;
           renderedReused += shown[e].reusedFrom && (*shown[e].reusedFrom)[i] != kNotReused;
         }
+        where += "; eye " + std::to_string(e) + ": " + std::to_string(counts[e]) + " pixels (rendered non-finite: " +
+                 std::to_string(renderedBad) + ")";
         if (firstRendered < pixels)
           where += " [rendered: " + std::to_string(renderedReused) + " reused; the first at (" +
                    std::to_string(firstRendered % size_t(scene.rig.width)) + ", " +
