@@ -109,49 +109,6 @@ EyeImage shownImage(const Variant& v) {
   return v.taa ? EyeImage::Displayed : v.denoise ? EyeImage::Denoised : EyeImage::Rendered;
 }
 
-// Where the first frame with non-finite pixels has them, per eye: how many the eye shows and how
-// many its eye pass rendered, of those how many the right eye reused, and the first rendered one
-// (its value, depth and the left pixel it reused) or else the first shown one.
-std::string describeNonFinite(FrameRenderer& renderer, EyeImage displayed, bool reusing) {
-  std::string out;
-  for (Eye eye : {Eye::Left, Eye::Right}) {
-    const int e = int(eye);
-    EyeResult shown, rendered;
-    EyeReadback what;
-    what.image = displayed;
-    renderer.backend().readEye(eye, what, shown);
-    what.image = EyeImage::Rendered;
-    what.reusedFrom = reusing && eye == Eye::Right;
-    renderer.backend().readEye(eye, what, rendered);
-    const size_t n = rendered.image.pixels.size();
-    size_t shownBad = 0, renderedBad = 0, reusedBad = 0, first = n;
-    for (size_t i = 0; i < n; ++i) {
-      shownBad += !isFinite(shown.image.pixels[i]);
-      if (isFinite(rendered.image.pixels[i])) continue;
-      ++renderedBad;
-      reusedBad += rendered.reusedFrom && (*rendered.reusedFrom)[i] != kNotReused;
-      if (first == n) first = i;
-    }
-    const std::vector<Vec3>& image = first < n ? rendered.image.pixels : shown.image.pixels;
-    if (first == n)
-      for (size_t i = 0; i < n && first == n; ++i)
-        if (!isFinite(shown.image.pixels[i])) first = i;
-    char line[480];
-    std::snprintf(line, sizeof line, "%seye %d: %zu shown, %zu rendered (%zu reused)", e ? "; " : "", e, shownBad,
-                  renderedBad, reusedBad);
-    out += line;
-    if (first == n) continue;
-    const Vec3 c = image[first];
-    const uint32_t source = rendered.reusedFrom ? (*rendered.reusedFrom)[first] : kNotReused;
-    std::snprintf(line, sizeof line, ", the first %s at (%zu, %zu): (%g, %g, %g), inverse depth %g, %s",
-                  renderedBad ? "rendered" : "shown", first % size_t(rendered.image.width), first / size_t(rendered.image.width),
-                  c.x, c.y, c.z, rendered.inverseDepth[first],
-                  source == kNotReused ? "shaded by its eye" : ("reused left pixel " + std::to_string(source)).c_str());
-    out += line;
-  }
-  return out;
-}
-
 std::vector<const Variant*> selectedVariants(const std::string& names) {
   const std::vector<std::string> asked = names.empty() ? std::vector<std::string>() : splitList(names, ';');
   for (const std::string& name : asked)
@@ -428,7 +385,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
         if ((counts[0] || counts[1] || rendered[0] || rendered[1]) && firstNonFinite < 0) {
           firstNonFinite = f;
           std::printf("| %s | %s | first non-finite pixels at still frame %d (still %d): %s |\n", scene.name.c_str(), v.name,
-                      f, renderer->stillFrames(), describeNonFinite(*renderer, shownImage(v), v.stereo != StereoMode::Separate).c_str());
+                      f, renderer->stillFrames(), describeNonFinitePixels(*renderer, shownImage(v), v.stereo != StereoMode::Separate).c_str());
         }
         if (slot < 0) continue;
         for (int e = 0; e < 2; ++e) nonFinite[slot] += nonFinitePixels(r.eyes[e].image);

@@ -476,55 +476,12 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
                                        gpu.backend().deviceImage(Eye::Right, EyeImage::Rendered)};
       counter.count(renderedImages, pixels, gpu.deviceStream(), renderedCounts);
       if (!counts[0] && !counts[1] && !renderedCounts[0] && !renderedCounts[1]) continue;
-      // Where: the first such pixel of each eye, what the eye pass rendered there (non-finite
-      // already: the eye pass; finite: the denoiser), and for a reused right pixel the left's.
-      std::string where = std::string(stereo == StereoMode::Gather ? "gather" : "separate") + ", ray schedule " +
-                          rayScheduleName(schedule) + ", memory filled with " +
-                          std::to_string(fill) + ", frame " +
-                          std::to_string(f) + " (still " + std::to_string(gpu.stillFrames()) + ")";
-      EyeResult shown[2], rendered[2];
-      for (int e = 0; e < 2; ++e) {
-        EyeReadback what;
-        what.image = EyeImage::Denoised;  // (no TAA here: nothing displayed apart)
-        what.reusedFrom = e == 1 && stereo == StereoMode::Gather;
-        gpu.backend().readEye(Eye(e), what, shown[e]);
-        what.image = EyeImage::Rendered;
-        gpu.backend().readEye(Eye(e), what, rendered[e]);
-      }
-      auto describe = [](const Vec3& c) {
-        return "(" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) + ")";
-      };
-      for (int e = 0; e < 2; ++e) {
-        const std::vector<Vec3>& image = shown[e].image.pixels;
-        const auto bad = std::find_if(image.begin(), image.end(), [](const Vec3& c) { return !isFinite(c); });
-        // The rendered ones: how many, reused or shaded by the eye, and the first with its depth.
-        size_t renderedBad = 0, renderedReused = 0, firstRendered = pixels;
-        for (size_t i = 0; i < pixels; ++i) {
-          if (isFinite(rendered[e].image.pixels[i])) continue;
-          ++renderedBad;
-          if (firstRendered == pixels) firstRendered = i;
-          renderedReused += shown[e].reusedFrom && (*shown[e].reusedFrom)[i] != kNotReused;
-        }
-        where += "; eye " + std::to_string(e) + ": " + std::to_string(counts[e]) + " pixels (rendered non-finite: " +
-                 std::to_string(renderedBad) + ")";
-        if (firstRendered < pixels)
-          where += " [rendered: " + std::to_string(renderedReused) + " reused; the first at (" +
-                   std::to_string(firstRendered % size_t(scene.rig.width)) + ", " +
-                   std::to_string(firstRendered / size_t(scene.rig.width)) + "), inverse depth " +
-                   std::to_string(rendered[e].inverseDepth[firstRendered]) + ", " +
-                   describe(rendered[e].image.pixels[firstRendered]) + "]";
-        if (bad == image.end()) continue;
-        const size_t i = size_t(bad - image.begin());
-        where += ", the first at (" + std::to_string(i % size_t(scene.rig.width)) + ", " +
-                 std::to_string(i / size_t(scene.rig.width)) + "), inverse depth " + std::to_string(shown[e].inverseDepth[i]) +
-                 ", rendered " + describe(rendered[e].image.pixels[i]);
-        const uint32_t source = shown[e].reusedFrom ? (*shown[e].reusedFrom)[i] : kNotReused;
-        if (source != kNotReused)
-          where += ", reused left pixel " + std::to_string(source) + " (left shown " + describe(shown[0].image.pixels[source]) +
-                   ", rendered " + describe(rendered[0].image.pixels[source]) + ")";
-        else if (shown[e].reusedFrom)
-          where += ", shaded by the right eye";
-      }
+      // Where: per eye the counts, how many of the rendered ones were reused, and the first such
+      // pixel (non-finite already in the eye pass's image, or only after the denoiser).
+      const std::string where = std::string(stereo == StereoMode::Gather ? "gather" : "separate") + ", ray schedule " +
+                                rayScheduleName(schedule) + ", memory filled with " + std::to_string(fill) + ", frame " +
+                                std::to_string(f) + " (still " + std::to_string(gpu.stillFrames()) + "): " +
+                                describeNonFinitePixels(gpu, EyeImage::Denoised, stereo == StereoMode::Gather);
       ADD_FAILURE() << where;
       break;  // the next run
     }

@@ -1,5 +1,7 @@
 #include "pvr/render/renderer.h"
 
+#include <cstdio>
+
 #include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/util/error.h"
 #ifdef PVR_HAVE_CUDA
@@ -87,6 +89,55 @@ void DeviceImageCheck::count(const Vec3* const images[2], size_t pixels, void* s
 #else
   (void)images, (void)pixels, (void)stream;
 #endif
+}
+
+std::string describeNonFinitePixels(FrameRenderer& frames, EyeImage shown, bool reusing) {
+  std::string out;
+  EyeResult rendered[2];
+  for (Eye eye : {Eye::Left, Eye::Right}) {
+    const int e = int(eye);
+    EyeResult seen;
+    EyeReadback what;
+    what.image = shown;
+    frames.backend().readEye(eye, what, seen);
+    what.image = EyeImage::Rendered;
+    what.reusedFrom = reusing && eye == Eye::Right;
+    frames.backend().readEye(eye, what, rendered[e]);
+    const EyeResult& r = rendered[e];
+    const size_t n = r.image.pixels.size();
+    size_t shownBad = 0, renderedBad = 0, reusedBad = 0, first = n;
+    for (size_t i = 0; i < n; ++i) {
+      shownBad += !isFinite(seen.image.pixels[i]);
+      if (isFinite(r.image.pixels[i])) continue;
+      ++renderedBad;
+      reusedBad += r.reusedFrom && (*r.reusedFrom)[i] != kNotReused;
+      if (first == n) first = i;
+    }
+    const std::vector<Vec3>& image = first < n ? r.image.pixels : seen.image.pixels;
+    if (first == n)
+      for (size_t i = 0; i < n && first == n; ++i)
+        if (!isFinite(seen.image.pixels[i])) first = i;
+    char line[480];
+    std::snprintf(line, sizeof line, "%seye %d: %zu shown, %zu rendered (%zu reused)", e ? "; " : "", e, shownBad,
+                  renderedBad, reusedBad);
+    out += line;
+    if (first == n) continue;
+    const Vec3 c = image[first];
+    std::snprintf(line, sizeof line, ", the first %s at (%zu, %zu): (%g, %g, %g), inverse depth %g, ",
+                  renderedBad ? "rendered" : "shown", first % size_t(r.image.width), first / size_t(r.image.width), c.x,
+                  c.y, c.z, r.inverseDepth[first]);
+    out += line;
+    const uint32_t source = r.reusedFrom ? (*r.reusedFrom)[first] : kNotReused;
+    if (source == kNotReused) {
+      out += "shaded by its eye";
+    } else {
+      const Vec3 left = rendered[0].image.pixels[source];
+      std::snprintf(line, sizeof line, "reused left pixel %u (left rendered (%g, %g, %g))", source, left.x, left.y,
+                    left.z);
+      out += line;
+    }
+  }
+  return out;
 }
 
 FrameResult Renderer::renderFrame(const Pose& head, const float gaze[2], FrameOutput output) {

@@ -89,4 +89,10 @@ class DeviceImageCheck {
   std::unique_ptr<Impl> impl_;
 };
 
+// Where a frame renderer's last frame has non-finite pixels, per eye, read back: how many the eye
+// shows (`shown`: the last stage the frame ran) and how many its eye pass rendered, of those how
+// many the right eye reused (`reusing`: gather reuse), and the first rendered one (its position,
+// value, depth and the left pixel it reused), else the first shown one. For a failure's report.
+std::string describeNonFinitePixels(FrameRenderer& frames, EyeImage shown, bool reusing);
+
 }  // namespace pvr
