@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <string>
@@ -142,8 +143,8 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
     std::replace_if(file.begin(), file.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)) && ch != '-'; }, '_');
     const std::string profilePath = args.profiles.empty() ? "" : args.profiles + "_" + file + ".json";
     const bool calibrated = !profilePath.empty() && std::filesystem::exists(profilePath);
-    const ControlProfile profile = calibrated ? ControlProfile::load(profilePath, scene.effectGroupNames())
-                                              : ControlProfile::generic(scene.effectGroupNames());
+    ControlProfile profile = calibrated ? ControlProfile::load(profilePath, scene.effectGroupNames())
+                                        : ControlProfile::generic(scene.effectGroupNames());
     const FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
     // The sampled views' references.
     std::vector<SampledView> views;
@@ -165,10 +166,32 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
     std::printf("| %s | %zu frames, %dx%d per eye, radius %g, profile %s, %zu reference views |\n", scene.name.c_str(),
                 trajectory.size(), rig.width, rig.height, base.gather.density.radius,
                 calibrated ? profilePath.c_str() : "generic (no calibrated profile found)", views.size());
-    std::printf("| scene | budget | policy | frame mean / p50 / p99 | over budget | mean relMSE | meets budget | check |\n"
-                "|---|---|---|---|---|---|---|---|\n");
     BudgetControllerParams params;
     params.foveationAvailable = true;
+    if (!args.profileOut.empty()) {
+      // The quality model fitted on this walk (a single view's error misjudges what the walk's
+      // frames show: a short history for the denoiser, the gaze's travel for foveation): the best
+      // setting and each knob's step from it alone, walked fixed and compared at the reference
+      // views. The costs stay the profile's.
+      const BudgetController start(profile, params, base, &mask);
+      profile.fitErrors(start.best(), [&](const ControlSetting& s) {
+        const RenderOptions o = start.optionsFor(s);
+        const Walk w = walk(*renderer, rig, trajectory, views, [&](double) { return o; },
+                            [](const StageTimings&, double) {}, args.fixedStride);
+        std::printf("| %s | fitting the quality model: %s, mean relMSE %.4f |\n", scene.name.c_str(),
+                    BudgetController::toJson(s, profile).dump().c_str(), w.meanError());
+        return w.meanError();
+      });
+      profile.validate();
+      const std::string path = args.profileOut + "_" + file + ".json";
+      std::ofstream out(path);
+      if (!out) throw Error("cannot write '" + path + "'");
+      out << profile.toJson().dump(2) << "\n";
+      std::printf("| %s | wrote the profile with the walk's quality model, %s; the controller below uses it |\n",
+                  scene.name.c_str(), path.c_str());
+    }
+    std::printf("| scene | budget | policy | frame mean / p50 / p99 | over budget | mean relMSE | meets budget | check |\n"
+                "|---|---|---|---|---|---|---|---|\n");
     const BudgetController model(profile, params, base, &mask);  // the ladder's settings and their options
     std::vector<Walk> controlled;
     std::map<std::string, ControlSetting> candidates;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -86,18 +87,24 @@ ControlProfile calibrate(FrameRenderer& renderer, const Scene& scene, const Ster
     o.denoise.params.refineWhenStill = false;  // a moving head's denoiser: no refinement
     return measure(renderer, rig, o, 2, frames, reference, o.denoise.enabled);
   };
-  const Measured best = run(top);
-  const double topError = meanError(best);
-  p.topError = topError;
+  // Each setting's run, kept for the costs below; the quality model from their errors.
+  std::map<std::string, Measured> runs;
+  auto measured = [&](const ControlSetting& s) -> const Measured& {
+    const std::string key = BudgetController::toJson(s, p).dump();
+    auto it = runs.find(key);
+    if (it == runs.end()) it = runs.emplace(key, run(s)).first;
+    return it->second;
+  };
+  p.fitErrors(top, [&](const ControlSetting& s) { return meanError(measured(s)); });
+  const Measured& best = measured(top);
   std::printf("| %s | calibration: best setting %s, relMSE %.4f, %.2f ms |\n", scene.name.c_str(),
-              BudgetController::toJson(top, p).dump().c_str(), topError, best.frame.mean);
-  // Each photon step's error, and its photon and density times for the costs' affine fits.
+              BudgetController::toJson(top, p).dump().c_str(), meanError(best), best.frame.mean);
+  // The photon and density times of the photon steps, for the costs' affine fits.
   std::vector<double> counts, photonMs, densityMs;
   for (size_t i = 0; i < p.photonSides.size(); ++i) {
     ControlSetting s = top;
     s.photons = int(i);
-    const Measured m = int(i) == top.photons ? best : run(s);
-    p.photonError[i] = int(i) == top.photons ? 0.0 : meanError(m) - topError;
+    const Measured& m = measured(s);
     counts.push_back(double(p.photonSides[i]) * p.photonSides[i]);
     photonMs.push_back(m.photons.mean), densityMs.push_back(m.density.mean);
   }
@@ -112,30 +119,18 @@ ControlProfile calibrate(FrameRenderer& renderer, const Scene& scene, const Ster
   };
   p.photonFixedShare = fixedShare(photonMs);
   p.densityFixedShare = fixedShare(densityMs);
-  for (size_t i = 0; i < p.radiusScales.size(); ++i) {
-    ControlSetting s = top;
-    s.radius = int(i);
-    p.radiusError[i] = int(i) == top.radius ? 0.0 : meanError(run(s)) - topError;
-  }
   double denoiseMs = 0, denoisePasses = 0;
   for (size_t i = 0; i < p.denoiseIterations.size(); ++i) {
     ControlSetting s = top;
     s.denoise = int(i);
-    const Measured m = int(i) == top.denoise ? best : run(s);
-    p.denoiseError[i] = meanError(m) - topError;
+    const Measured& m = measured(s);
     if (p.denoiseIterations[i] > 0) denoiseMs += m.denoiseMs, denoisePasses += p.denoisePasses(int(i));
   }
-  // The errors were measured from the best setting's denoiser: make them relative to none.
-  const double none = p.denoiseError[0];
-  for (double& e : p.denoiseError) e -= none;
-  p.topError += none;
-  for (double& e : p.photonError) e = std::max(0.0, e);
   if (denoisePasses > 0) p.denoiseMsPerIteration = denoiseMs / denoisePasses;
   {
     ControlSetting s = top;
     s.foveated = true;
-    const Measured m = run(s);
-    p.foveatedError = meanError(m) - topError;
+    const Measured& m = measured(s);
     // The eye pass's time, not its sample count: the foveated pass does not shrink with its samples
     // (on the H200's Sponza 2.6 % of the samples took 8 % of the time).
     const double full = best.rays.mean + best.density.mean, foveated = m.rays.mean + m.density.mean;
@@ -148,8 +143,7 @@ ControlProfile calibrate(FrameRenderer& renderer, const Scene& scene, const Ster
       if (level == top.levels[g]) continue;
       ControlSetting s = top;
       s.levels[g] = uint8_t(level);
-      const Measured m = run(s);
-      p.levelError[g][size_t(level)] = std::max(0.0, meanError(m) - topError);
+      const Measured& m = measured(s);
       p.levelRayCost[g][size_t(level)] = m.rays.mean / topRays - 1.0;
       if (level == int(EffectLevel::Raster)) p.densityShare[g] = std::clamp(1.0 - m.density.mean / topDensity, 0.0, 1.0);
     }

@@ -1014,7 +1014,8 @@ int runFrameBench(const FrameBenchArgs& args) {
       args.suite != "foveation" && args.suite != "scenes" && args.suite != "quality" && args.suite != "effects" &&
       args.suite != "controller" && args.suite != "all")
     throw Error("--suite must be tables, stereo, foveation, scenes, quality, effects, controller, rays, grid or all, got '" + args.suite + "'");
-  if (!args.profileOut.empty() && args.suite != "effects") throw Error("--profile-out is for --suite effects");
+  if (!args.profileOut.empty() && args.suite != "effects" && args.suite != "controller")
+    throw Error("--profile-out is for --suite effects or controller");
   if (!(args.sceneRadius > 0.0f) || !std::isfinite(args.sceneRadius)) throw Error("--scene-radius must be a positive number");
   if (args.frames < 1 || args.frames > 100000) throw Error("--frames must be between 1 and 100000");
   if (args.warmup < 0 || args.warmup > 100000) throw Error("--warmup must be between 0 and 100000");

@@ -36,7 +36,7 @@ struct FrameBenchArgs {
   std::string qualityImages;  ///< quality suite: PNG prefix (empty: none)
   std::string qualityVariants;  ///< quality suite: variant names separated by ';' (empty: all)
   std::string effectsScenes = "cornell-caustics,cornell-dense,scenes/dabrovic-sponza.json,scenes/sibenik.json";  ///< effects suite
-  std::string profileOut;     ///< effects suite: the controller's calibrated profiles, PREFIX_<scene>.json (empty: none)
+  std::string profileOut;     ///< effects suite: the controller's calibrated profiles; controller suite: with the walk's quality model; PREFIX_<scene>.json (empty: none)
   std::string walks;          ///< controller suite: SCENE=TRAJECTORY,...
   std::string budgets = "11.1,5.5";  ///< controller suite: frame budgets, ms
   std::string profiles;       ///< controller suite: read PREFIX_<scene>.json where it exists (else the generic model)

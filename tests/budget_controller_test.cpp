@@ -295,6 +295,41 @@ TEST(BudgetController, PredictsOtherSettingsFromOneMeasuredFrame) {
     ASSERT_NEAR(c.predictMs(s), frameCosts(c, s, f).total(), 1e-9);
 }
 
+// The quality model fitted from measurements (the effects suite at a view, the controller suite
+// on a walk): measured errors that follow an additive model (another profile's, its photon terms
+// weighted by the groups at gi) give back that model's prediction for every setting, each knob's
+// step measured alone from the best setting; a measured step that lowers the error where the
+// model cannot (photons, levels: noise) counts as 0.
+TEST(BudgetController, FittedErrorsReproduceTheMeasuredModel) {
+  ControlProfile truth = twoGroups();
+  truth.topError = 0.031;
+  truth.photonError = {0.09, 0.06, 0.04, 0.025, 0.012, 0.004, 0.0};
+  truth.radiusError = {0.011, 0.0, 0.002};
+  truth.denoiseError = {0.0, -0.004, -0.009, -0.010, -0.0105};
+  truth.foveatedError = 0.037;
+  truth.levelError = {{0.21, 0.05, 0.02, 0.0}, {0.13, 0.03, 0.01, 0.0}};
+  const BudgetController measured(truth, paramsFor(kFrameMs), RenderOptions(), &kMask);
+  ControlProfile fitted = twoGroups();  // the generic model's errors, to be replaced
+  int calls = 0;
+  fitted.fitErrors(measured.best(), [&](const ControlSetting& s) { return ++calls, measured.predictError(s); });
+  EXPECT_EQ(calls, 1 + 6 + 2 + 4 + 1 + 2 * 3);  // the top, and each other step alone
+  fitted.validate();
+  const BudgetController model(fitted, paramsFor(kFrameMs), RenderOptions(), &kMask);
+  EXPECT_EQ(model.best(), measured.best());
+  for (const ControlSetting& s : everySetting(fitted, true))
+    ASSERT_NEAR(model.predictError(s), measured.predictError(s), 1e-12);
+
+  // A measured photon or level step below the top's error (noise) is no gain in the model.
+  ControlProfile noisy = twoGroups();
+  noisy.fitErrors(measured.best(), [&](const ControlSetting& s) {
+    const bool fewerPhotons = s.photons == 5, floorShadows = s.levels[1] == uint8_t(EffectLevel::Shadows);
+    return measured.predictError(s) - (fewerPhotons ? 0.02 : 0.0) - (floorShadows ? 0.05 : 0.0);
+  });
+  EXPECT_EQ(noisy.photonError[5], 0.0);
+  EXPECT_EQ(noisy.levelError[1][size_t(EffectLevel::Shadows)], 0.0);
+  EXPECT_NEAR(noisy.photonError[4], truth.photonError[4], 1e-12);
+}
+
 TEST(BudgetController, OptionsCarryTheSetting) {
   RenderOptions base;
   base.gather.density.radius = 0.1f;

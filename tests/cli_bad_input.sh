@@ -108,7 +108,7 @@ expect_error "cannot open controller profile" render cornell --backend cpu --bud
 echo '{"error": {"top": 0.1}}' >"$out/short_profile.json"
 expect_error "controller profile '$out/short_profile.json'" render cornell --backend cpu --budget-ms 11.1 \
   --controller-profile "$out/short_profile.json" --trajectory "$out/one.traj" "${small[@]}"
-expect_error "--profile-out is for --suite effects" bench --suite tables --profile-out "$out/p"
+expect_error "--profile-out is for --suite effects or controller" bench --suite tables --profile-out "$out/p"
 expect_error "--walks must name SCENE=TRAJECTORY" bench --suite controller --backend cpu
 expect_error "--budgets must be" bench --suite controller --backend cpu --walks "cornell=$out/one.traj" --budgets 5,x
 expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty

@@ -897,7 +897,8 @@ int runCli(int argc, char** argv, CliRun run) {
   bench->add_option("--effects-scenes", fa.effectsScenes, "Scenes of the effects suite (absent meshes are skipped)")
       ->capture_default_str();
   bench->add_option("--profile-out", fa.profileOut,
-                    "Effects suite: calibrate the budget controller on each scene, writing PREFIX_<scene>.json");
+                    "Effects suite: calibrate the budget controller on each scene, writing PREFIX_<scene>.json; controller "
+                    "suite: fit its quality model on each walk (from --profiles' costs) and write it there");
   bench->add_option("--walks", fa.walks, "Controller suite: SCENE=TRAJECTORY,... (scripts/walk_trajectory.py makes walks)");
   bench->add_option("--budgets", fa.budgets, "Controller suite: frame budgets in ms")->capture_default_str();
   bench->add_option("--profiles", fa.profiles, "Controller suite: use PREFIX_<scene>.json (from --profile-out) where it exists");

@@ -146,6 +146,28 @@ double ControlProfile::denoisePasses(int step) const {
   return double(direct) + photonMapPassShare * double(n - direct);
 }
 
+void ControlProfile::fitErrors(const ControlSetting& top, const std::function<double(const ControlSetting&)>& errorOf) {
+  const double topMeasured = errorOf(top);
+  auto step = [&](auto change) {
+    ControlSetting s = top;
+    change(s);
+    return s == top ? 0.0 : errorOf(s) - topMeasured;
+  };
+  for (size_t i = 0; i < photonSides.size(); ++i)
+    photonError[i] = std::max(0.0, step([&](ControlSetting& s) { s.photons = int(i); }));
+  for (size_t i = 0; i < radiusScales.size(); ++i) radiusError[i] = step([&](ControlSetting& s) { s.radius = int(i); });
+  for (size_t i = 0; i < denoiseIterations.size(); ++i) denoiseError[i] = step([&](ControlSetting& s) { s.denoise = int(i); });
+  // Measured from the top's denoiser: made relative to none, which the top error then includes.
+  const double none = denoiseError[0];
+  for (double& e : denoiseError) e -= none;
+  topError = topMeasured + none;
+  foveatedError = step([](ControlSetting& s) { s.foveated = true; });
+  for (size_t g = 0; g < groups.size(); ++g)
+    for (int level = 0; level < kControlledLevels; ++level)
+      levelError[g][size_t(level)] =
+          level == top.levels[g] ? 0.0 : std::max(0.0, step([&](ControlSetting& s) { s.levels[g] = uint8_t(level); }));
+}
+
 ControlProfile ControlProfile::load(const std::string& path, const std::vector<std::string>& sceneGroups) {
   std::ifstream in(path);
   if (!in) throw Error("cannot open controller profile '" + path + "': no such file or not readable");

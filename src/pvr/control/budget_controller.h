@@ -22,6 +22,7 @@
 // `maxRaisesPerSecond`, and only for a gain above `minGain`: no oscillation, no popping.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,11 @@ struct ControlProfile {
   double photonMapPassShare = 0.78;
   // A denoise step's cost in passes over both signals (the denoise cost's scale).
   double denoisePasses(int step) const;
+  // Sets the quality model from measurements: `errorOf(setting)` is the relMSE a setting gives
+  // (at one view, or the mean over a walk's reference views). `top` (the best setting) and each
+  // knob's step from it alone are measured; the terms are the differences, the denoiser's relative
+  // to no denoiser, photon and level steps never below 0. Costs are left as they are.
+  void fitErrors(const ControlSetting& top, const std::function<double(const ControlSetting&)>& errorOf);
 
   // The generic model for a scene with these groups: variance ~ 1 / (photons x radius^2), bias ~
   // radius^2, each group's levels by its share, the foveated frame 4x cheaper.
