@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <utility>
 
@@ -482,7 +483,41 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
                                 rayScheduleName(schedule) + ", memory filled with " + std::to_string(fill) + ", frame " +
                                 std::to_string(f) + " (still " + std::to_string(gpu.stillFrames()) + "): " +
                                 describeNonFinitePixels(gpu, EyeImage::Denoised, stereo == StereoMode::Gather);
-      ADD_FAILURE() << where;
+      // Where the first non-finite rendered pixel's radiance came from: its direct part (shadow
+      // rays and emission, finite: the photon-map estimate), and the map's photons.
+      std::string origin;
+      auto& cuda = dynamic_cast<CudaFrameBackend&>(gpu.backend());
+      for (int e = 0; e < 2; ++e) {
+        EyeResult rendered;
+        gpu.backend().readEye(Eye(e), EyeReadback(), rendered);
+        const auto& image = rendered.image.pixels;
+        const auto bad = std::find_if(image.begin(), image.end(), [](const Vec3& c) { return !isFinite(c); });
+        if (bad == image.end()) continue;
+        Vec3 direct;
+        ASSERT_EQ(cudaMemcpy(&direct, cuda.deviceDirect(Eye(e)) + (bad - image.begin()), sizeof(Vec3), cudaMemcpyDeviceToHost),
+                  cudaSuccess);
+        origin += "; eye " + std::to_string(e) + "'s first: direct part (" + std::to_string(direct.x) + ", " +
+                  std::to_string(direct.y) + ", " + std::to_string(direct.z) + ")";
+      }
+      const std::vector<Photon> photons = cuda.mapPhotonsToHost();
+      size_t badPower = 0, badPosition = 0;
+      std::vector<std::pair<float, size_t>> strongest;
+      for (size_t i = 0; i < photons.size(); ++i) {
+        badPower += !isFinite(photons[i].power);
+        badPosition += !isFinite(photons[i].position);
+        if (isFinite(photons[i].power)) strongest.push_back({maxComponent(photons[i].power), i});
+      }
+      std::sort(strongest.rbegin(), strongest.rend());
+      origin += "; map: " + std::to_string(photons.size()) + " photons, " + std::to_string(badPower) +
+                " with non-finite power, " + std::to_string(badPosition) + " with a non-finite position; strongest:";
+      for (size_t k = 0; k < strongest.size() && k < 3; ++k) {
+        const Photon& p = photons[strongest[k].second];
+        char line[160];
+        std::snprintf(line, sizeof line, " %g at (%g, %g, %g)", strongest[k].first, p.position.x, p.position.y,
+                      p.position.z);
+        origin += line;
+      }
+      ADD_FAILURE() << where << origin;
       break;  // the next run
     }
   }

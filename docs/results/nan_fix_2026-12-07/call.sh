@@ -10,6 +10,11 @@ for phase in "$@"; do
   case $phase in
   nantest)
     step nan_test 90 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=*ARefiningStillHead* ;;
+  nosparse)
+    # A variant build (not committed) whose reusing right eye estimates its gather points with the
+    # hybrid scheme's tiled kernel instead of a warp per listed point (eye_pass.cu: sparse = false),
+    # bundled beside the others: is that kernel the cause?
+    step nan_test_nosparse 90 .gpu/run.sh .gpu/bin/pvr_gpu_tests_nosparse --gtest_filter=*ARefiningStillHead* ;;
   tests)
     step gpu_tests 90 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=-*ARefiningStillHead* ;;
   scenes)

@@ -345,6 +345,18 @@ const Vec3* CudaFrameBackend::deviceImage(Eye eye, EyeImage which) const {
   return impl_->eyePass.image(eye);
 }
 
+const Vec3* CudaFrameBackend::deviceDirect(Eye eye) const { return impl_->eyePass.direct(eye); }
+
+std::vector<Photon> CudaFrameBackend::mapPhotonsToHost() {
+  Impl& m = *impl_;
+  std::vector<Photon> photons(m.mapPhotonCount());
+  if (!photons.empty())
+    PVR_CUDA_CHECK(cudaMemcpyAsync(photons.data(), m.mapPhotons(), photons.size() * sizeof(Photon),
+                                   cudaMemcpyDeviceToHost, m.stream));
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  return photons;
+}
+
 const float* CudaFrameBackend::deviceInverseDepth(Eye eye) const { return impl_->eyePass.inverseDepth(eye); }
 void* CudaFrameBackend::deviceStream() const { return impl_->stream; }
 

@@ -60,6 +60,10 @@ class CudaFrameBackend : public FrameBackend {
 
   // Tools for tests and benchmarks.
   std::vector<Photon> tracePhotonsToHost(const PhotonTraceParams& params);
+  // The photons of the map the last frame estimated from, and an eye pass's direct part (shadow
+  // rays and emission: the denoiser's guide) in device memory: where a pixel's radiance came from.
+  std::vector<Photon> mapPhotonsToHost();
+  const Vec3* deviceDirect(Eye eye) const;
   // Builds the hash grid over `photons` on the GPU `repeats` times; returns the median build time
   // in ms (CUDA events, cell keys to gathered photons; the photons' bounds are given, as the
   // tracer reduces them while tracing) and optionally the grid.
