@@ -430,9 +430,10 @@ void dirtyFreeDeviceMemory(int byte) {
 // eye's where it reused pixels), in memory left dirty, images left on the GPU as the bench leaves
 // them: no pixel of any frame is non-finite (counted on the GPU every frame); separate eyes too.
 // A failure names the frame, each eye's count, how many the eye pass itself rendered non-finite
-// (else the denoiser made them) and the first such pixel. It FAILS on 2026-12-06's code (H100 and
-// H200): the right eye's eye pass renders 20-30 non-finite pixels on some frames under gather
-// (docs/reliability.md). Needs PVR_SCENES (skipped without).
+// (else the denoiser made them), the first such pixel, its direct part and the map's photons. It
+// FAILS on the code of 2026-12-06/07 (H100 and H200): under gather with the Auto schedule the
+// right eye's listed pass renders 20-30 pixels at +Inf on some frames (docs/reliability.md).
+// Needs PVR_SCENES (skipped without).
 TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
   PVR_REQUIRE_GPU();
   if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
