@@ -518,6 +518,57 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
                       p.position.z);
         origin += line;
       }
+      // The right eye's (the last pass's) first bad pixel: the gather point its estimate started
+      // from, and that estimate redone here over the map's photons (the shared code, brute force).
+      EyeResult right;
+      gpu.backend().readEye(Eye::Right, EyeReadback(), right);
+      const auto& rightImage = right.image.pixels;
+      const auto bad = std::find_if(rightImage.begin(), rightImage.end(), [](const Vec3& c) { return !isFinite(c); });
+      if (bad != rightImage.end()) {
+        const GatherPoint point = cuda.gatherPointToHost(size_t(bad - rightImage.begin()));
+        const DenoiseParams& refine = o.denoise.params;
+        const float first = o.gather.density.radius;
+        const float radius = gpu.stillFrames() > 0 ? std::max(progressiveRadius(first, gpu.stillFrames(), refine.refineAlpha),
+                                                              first * refine.minRadiusFraction)
+                                                   : first;
+        Vec3 sum{0, 0, 0};
+        size_t within = 0, counted = 0, badContributions = 0, strongestIndex = photons.size();
+        float strongestValue = -1.0f;
+        for (size_t i = 0; i < photons.size(); ++i) {
+          const Vec3 offset = photons[i].position - point.position;
+          if (dot(offset, offset) > radius * radius) continue;
+          ++within;
+          if (!photonCounts(offset, photons[i].direction, point.normal, point.wall)) continue;
+          ++counted;
+          const Vec3 c = point.photonContribution(photons[i]);
+          badContributions += !isFinite(c);
+          const float value = isFinite(c) ? maxComponent(c) : INFINITY;
+          if (value > strongestValue) strongestValue = value, strongestIndex = i;
+          sum += c;
+        }
+        auto v3 = [](Vec3 v) {
+          char text[96];
+          std::snprintf(text, sizeof text, "(%g, %g, %g)", v.x, v.y, v.z);
+          return std::string(text);
+        };
+        origin += "; right eye's first: pixel " + std::to_string(bad - rightImage.begin()) + " " + v3(*bad) +
+                  ", gather point: radiance " + v3(point.radiance) + ", weight " + v3(point.weight) + ", position " +
+                  v3(point.position) + ", normal " + v3(point.normal) + ", wall " + v3(point.wall) + ", lobes " +
+                  std::to_string(point.lobes);
+        if (point.lobes)
+          origin += ", wo " + v3(point.wo) + ", shading normal " + v3(point.bsdf.normal) + ", base colour " +
+                    v3(point.bsdf.baseColor) + ", metallic " + std::to_string(point.bsdf.metallic) + ", alpha " +
+                    std::to_string(point.bsdf.alpha) + ", transmission " + std::to_string(point.bsdf.transmission);
+        origin += "; estimate redone at r = " + std::to_string(radius) + ": " + std::to_string(within) + " photons within, " +
+                  std::to_string(counted) + " counted, " + std::to_string(badContributions) +
+                  " non-finite contributions, sum " + v3(sum) + ", radiance " +
+                  v3(point.radiance + point.weight * sum * (1.0f / (kPi * radius * radius)));
+        if (strongestIndex < photons.size()) {
+          const Photon& p = photons[strongestIndex];
+          origin += "; its strongest photon: at " + v3(p.position) + ", direction " + v3(p.direction) + ", power " +
+                    v3(p.power) + ", contribution " + v3(point.photonContribution(p));
+        }
+      }
       ADD_FAILURE() << where << origin;
       break;  // the next run
     }

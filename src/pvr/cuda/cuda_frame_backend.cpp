@@ -357,6 +357,27 @@ std::vector<Photon> CudaFrameBackend::mapPhotonsToHost() {
   return photons;
 }
 
+GatherPoint CudaFrameBackend::gatherPointToHost(size_t pixel) {
+  Impl& m = *impl_;
+  const cuda::DeviceGatherPoints& points = m.eyePass.gatherPoints();
+  if (pixel >= points.lobe.capacity()) throw Error("gather point " + std::to_string(pixel) + " is past the eye pass's store");
+  float4 planes[cuda::kGatherPointPlanes];
+  cuda::GatherPointLobe lobe{};
+  for (int k = 0; k < cuda::kGatherPointPlanes; ++k)
+    PVR_CUDA_CHECK(cudaMemcpyAsync(&planes[k], points.planes[k].data() + pixel, sizeof(float4), cudaMemcpyDeviceToHost, m.stream));
+  PVR_CUDA_CHECK(cudaMemcpyAsync(&lobe, points.lobe.data() + pixel, sizeof lobe, cudaMemcpyDeviceToHost, m.stream));
+  PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));
+  // GatherPointStore's layout, read on the host.
+  auto xyz = [](float4 v) { return Vec3{v.x, v.y, v.z}; };
+  GatherPoint p;
+  p.radiance = xyz(planes[cuda::kPlaneRadiance]), p.weight = xyz(planes[cuda::kPlaneWeight]);
+  p.position = xyz(planes[cuda::kPlanePosition]), p.normal = xyz(planes[cuda::kPlaneNormal]);
+  std::memcpy(&p.lobes, &planes[cuda::kPlaneRadiance].w, sizeof p.lobes);
+  p.wall = {planes[cuda::kPlaneWeight].w, planes[cuda::kPlanePosition].w, planes[cuda::kPlaneNormal].w};
+  if (p.lobes) p.wo = lobe.wo, p.bsdf = lobe.bsdf;
+  return p;
+}
+
 const float* CudaFrameBackend::deviceInverseDepth(Eye eye) const { return impl_->eyePass.inverseDepth(eye); }
 void* CudaFrameBackend::deviceStream() const { return impl_->stream; }
 

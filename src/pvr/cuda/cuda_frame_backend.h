@@ -8,6 +8,7 @@
 
 #include "pvr/accel/bvh.h"
 #include "pvr/pipeline/frame_renderer.h"
+#include "pvr/photon/gather.h"
 #include "pvr/photon/photon.h"
 
 struct CUstream_st;  // cudaStream_t
@@ -64,6 +65,9 @@ class CudaFrameBackend : public FrameBackend {
   // rays and emission: the denoiser's guide) in device memory: where a pixel's radiance came from.
   std::vector<Photon> mapPhotonsToHost();
   const Vec3* deviceDirect(Eye eye) const;
+  // Pixel `pixel`'s gather point as the last full-resolution eye pass stored it for its density
+  // estimate (its last sample; under stereo the right eye's): what the estimate started from.
+  GatherPoint gatherPointToHost(size_t pixel);
   // Builds the hash grid over `photons` on the GPU `repeats` times; returns the median build time
   // in ms (CUDA events, cell keys to gathered photons; the photons' bounds are given, as the
   // tracer reduces them while tracing) and optionally the grid.

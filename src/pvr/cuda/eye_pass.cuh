@@ -138,6 +138,8 @@ class GpuEyePass {
   const Vec3* direct(Eye e) const { return direct_[int(e)].data(); }
   const Vec3* albedo(Eye e) const { return albedo_[int(e)].data(); }
   const Vec3* normal(Eye e) const { return normal_[int(e)].data(); }
+  // The gather points of the last full-resolution pass's last sample (the right eye's, under stereo).
+  const DeviceGatherPoints& gatherPoints() const { return points_; }
   // The right eye's reused-sample count, copied to the host when the stream reaches it.
   void downloadReusedCount(unsigned* host, cudaStream_t stream) const;
   size_t memoryBytes() const;
