@@ -14,6 +14,16 @@ for phase in "$@"; do
   case $phase in
   nantest)
     step nan_test 110 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=*ARefiningStillHead* --gtest_repeat=2 ;;
+  nandiag)
+    # A variant test binary (not committed) whose listed kernel, on a non-finite gather point,
+    # shades the pixel again (shared-memory stack, then local stack) and prints both with the
+    # thread's place (list index, block, SM, warp).
+    step nan_diag 150 .gpu/run.sh .gpu/bin/pvr_gpu_tests_diag --gtest_filter=*ARefiningStillHead* --gtest_repeat=3 ;;
+  sass)
+    # The listed kernel's machine code and the device functions it calls, for a liveness check of
+    # its registers (a read before any write would take a previous warp's leftovers).
+    dump=$(command -v cuobjdump || ls /usr/local/cuda*/bin/cuobjdump | head -1)
+    step sass_dump 120 bash -c "$dump -sass .gpu/bin/pvr_gpu_tests | awk '/Function : /{keep = \$0 ~ /listedEyeRaysKernel|eyeRaysKernelILNS_10StereoRoleE0ELb0E|DirectLight|pathTracedRadiance|clipAtBoundaries|bsdfAt|occlusionAt|sampleBsdf|texelPasses/} keep' | xz -6 > $results/listed_sass.txt.xz; ls -la $results/listed_sass.txt.xz" ;;
   initcheck)
     step initcheck 150 compute-sanitizer --tool initcheck --print-limit 30 "${render_still[@]}" ;;
   racecheck)
