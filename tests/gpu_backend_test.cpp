@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <utility>
 
 #include "gpu_ray_throughput.h"
@@ -488,12 +489,14 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
       // rays and emission, finite: the photon-map estimate), and the map's photons.
       std::string origin;
       auto& cuda = dynamic_cast<CudaFrameBackend&>(gpu.backend());
+      std::optional<std::pair<size_t, Vec3>> rightBad;  // the right eye's first: pixel, colour
       for (int e = 0; e < 2; ++e) {
         EyeResult rendered;
         gpu.backend().readEye(Eye(e), EyeReadback(), rendered);
         const auto& image = rendered.image.pixels;
         const auto bad = std::find_if(image.begin(), image.end(), [](const Vec3& c) { return !isFinite(c); });
         if (bad == image.end()) continue;
+        if (Eye(e) == Eye::Right) rightBad = {size_t(bad - image.begin()), *bad};
         Vec3 direct;
         ASSERT_EQ(cudaMemcpy(&direct, cuda.deviceDirect(Eye(e)) + (bad - image.begin()), sizeof(Vec3), cudaMemcpyDeviceToHost),
                   cudaSuccess);
@@ -520,12 +523,9 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
       }
       // The right eye's (the last pass's) first bad pixel: the gather point its estimate started
       // from, and that estimate redone here over the map's photons (the shared code, brute force).
-      EyeResult right;
-      gpu.backend().readEye(Eye::Right, EyeReadback(), right);
-      const auto& rightImage = right.image.pixels;
-      const auto bad = std::find_if(rightImage.begin(), rightImage.end(), [](const Vec3& c) { return !isFinite(c); });
-      if (bad != rightImage.end()) {
-        const GatherPoint point = cuda.gatherPointToHost(size_t(bad - rightImage.begin()));
+      if (rightBad) {
+        const auto [badPixel, badColour] = *rightBad;
+        const GatherPoint point = cuda.gatherPointToHost(badPixel);
         const DenoiseParams& refine = o.denoise.params;
         const float first = o.gather.density.radius;
         const float radius = gpu.stillFrames() > 0 ? std::max(progressiveRadius(first, gpu.stillFrames(), refine.refineAlpha),
@@ -551,7 +551,7 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
           std::snprintf(text, sizeof text, "(%g, %g, %g)", v.x, v.y, v.z);
           return std::string(text);
         };
-        origin += "; right eye's first: pixel " + std::to_string(bad - rightImage.begin()) + " " + v3(*bad) +
+        origin += "; right eye's first: pixel " + std::to_string(badPixel) + " " + v3(badColour) +
                   ", gather point: radiance " + v3(point.radiance) + ", weight " + v3(point.weight) + ", position " +
                   v3(point.position) + ", normal " + v3(point.normal) + ", wall " + v3(point.wall) + ", lobes " +
                   std::to_string(point.lobes);
