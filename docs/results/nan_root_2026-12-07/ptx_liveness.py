@@ -92,6 +92,22 @@ def defs_uses(ins):
     if op.startswith('mov') and 0: pass
     return d, u, op, rest
 
+def backward_live(gen, kill, succ, kills_all=None):
+    """Live-in sets per block: gen | (union of the successors' live-in - kill), to a fixed point.
+    A block in kills_all (a call that clobbers everything) passes nothing through."""
+    live_in = [set() for _ in gen]
+    changed = True
+    while changed:
+        changed = False
+        for bi in range(len(gen) - 1, -1, -1):
+            out = set()
+            for s in succ[bi]: out |= live_in[s]
+            new = gen[bi] | (set() if kills_all and kills_all[bi] else out - kill[bi])
+            if new != live_in[bi]:
+                live_in[bi] = new; changed = True
+    return live_in
+
+
 def analyze(name, body):
     stmts = parse(body)
     # basic blocks
@@ -146,16 +162,7 @@ def analyze(name, body):
             g |= (u - k)
             k |= d
         gen.append(g); kill.append(k)
-    live_in = [set() for _ in blocks]
-    changed = True
-    while changed:
-        changed = False
-        for bi in range(len(blocks) - 1, -1, -1):
-            out = set()
-            for s in succ[bi]: out |= live_in[s]
-            new = gen[bi] | (out - kill[bi])
-            if new != live_in[bi]:
-                live_in[bi] = new; changed = True
+    live_in = backward_live(gen, kill, succ)
     return live_in[0] if blocks else set(), blocks, gen, kill, succ, live_in
 
 if __name__ == '__main__':

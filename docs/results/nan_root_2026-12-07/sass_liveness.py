@@ -4,8 +4,11 @@ cuobjdump -sass (backward liveness at the function's entry). Calls are taken to 
 register and read none; function live-ins beyond the ABI's argument registers are suspects.
 Usage: sass_liveness.py FILE.sass [NAME_PART] [-v]. Checked on a hand-written snippet only: its
 operand widths and multi-destination forms are a best effort, not yet run on a real dump."""
-import re, sys
+import os, re, sys
 from collections import defaultdict
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ptx_liveness import backward_live
 
 INS = re.compile(r'/\*([0-9a-f]{4,})\*/\s+(.*?)\s*;')
 LABEL = re.compile(r'^\s*(\.L_x_\d+):')
@@ -137,16 +140,7 @@ def analyze(lines):
             if '*' in d: allk = True
             k |= d
         gen.append(g); kill.append((k, allk)); first_use.append(fu)
-    live = [set() for _ in blocks]
-    changed = True
-    while changed:
-        changed = False
-        for i in range(len(blocks) - 1, -1, -1):
-            out = set()
-            for s in succ[i]: out |= live[i if False else s]
-            k, allk = kill[i]
-            new = gen[i] | (set() if allk else (out - k))
-            if new != live[i]: live[i] = new; changed = True
+    live = backward_live(gen, [k for k, _ in kill], succ, [allk for _, allk in kill])
     return blocks, live, first_use, succ
 
 if __name__ == '__main__':
