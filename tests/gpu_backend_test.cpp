@@ -426,18 +426,21 @@ void dirtyFreeDeviceMemory(int byte) {
   (void)cudaGetLastError();
 }
 
+// How one still-head run is set up: the right eye's stereo mode, the GPU's ray schedule, and the
+// byte free device memory is filled with first.
+struct StillHeadRun {
+  StereoMode stereo;
+  RaySchedule schedule;
+  int fill;
+};
+
 // A still head refining for 5 s (450 frames) at the quality bench's settings on Dabrovic Sponza,
-// both eyes at full resolution, the right eye under gather reuse (its history refers to the left
-// eye's where it reused pixels), in memory left dirty, images left on the GPU as the bench leaves
-// them: no pixel of any frame is non-finite (counted on the GPU every frame); separate eyes too.
+// both eyes at full resolution, in memory left dirty, images left on the GPU as the bench leaves
+// them, for each run: no pixel of any frame is non-finite (counted on the GPU every frame).
 // A failure names the frame, each eye's count, how many the eye pass itself rendered non-finite
-// (else the denoiser made them), the first such pixel, its direct part and the map's photons. It
-// FAILS on the code of 2026-12-06/07 (H100 and H200): under gather with the Auto schedule the
-// right eye's listed pass renders 20-30 pixels at +Inf on some frames (docs/reliability.md).
-// Needs PVR_SCENES (skipped without).
-TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
-  PVR_REQUIRE_GPU();
-  if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
+// (else the denoiser made them), the first such pixel, its direct part, the map's photons, and
+// the right eye's first bad pixel's gather point with its estimate redone on the host.
+void expectStillHeadStaysFinite(const std::vector<StillHeadRun>& runs) {
   Scene scene;
   try {
     scene = loadScene("scenes/dabrovic-sponza.json");
@@ -445,19 +448,6 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
     GTEST_SKIP() << e.what();
   }
   const size_t pixels = size_t(scene.rig.width) * size_t(scene.rig.height);
-  // Memory full of NaN (0xff bytes) fails every test a read of it meets; memory full of 0.747
-  // (0x3f bytes) passes them, as the finite leftovers of earlier renderers do in the bench.
-  // The ray schedules tell the eye passes' paths apart: on Sponza (3 shadow queries a point) Auto
-  // defers the shadow rays of separate eyes and of the left eye under gather, and gives the
-  // reusing right eye its first hits apart and a listed pass over the pixels it does not reuse.
-  struct Run {
-    StereoMode stereo;
-    RaySchedule schedule;
-    int fill;
-  };
-  const Run runs[] = {{StereoMode::Separate, RaySchedule::Auto, 0xff},      {StereoMode::Gather, RaySchedule::Auto, 0xff},
-                      {StereoMode::Gather, RaySchedule::Auto, 0x3f},        {StereoMode::Separate, RaySchedule::FirstHits, 0xff},
-                      {StereoMode::Gather, RaySchedule::InKernel, 0xff},    {StereoMode::Gather, RaySchedule::Deferred, 0xff}};
   for (const auto& [stereo, schedule, fill] : runs) {
     dirtyFreeDeviceMemory(fill);
     FrameRenderer gpu = makeCudaFrameRenderer(scene);
@@ -573,6 +563,35 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
       break;  // the next run
     }
   }
+}
+
+// The still head under gather reuse (the right eye's history refers to the left eye's where it
+// reused pixels) and separate eyes, in memory full of NaN (0xff bytes: fails every test a read
+// of it meets) and of 0.747 (0x3f: passes them, as the finite leftovers of earlier renderers do
+// in the bench). The schedules tell the eye passes' paths apart: on Sponza (3 shadow queries a
+// point) Auto defers the shadow rays of separate eyes and of the left eye under gather, and
+// keeps the reusing right eye's rays in its eye kernel. Needs PVR_SCENES (skipped without).
+TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
+  PVR_REQUIRE_GPU();
+  if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
+  expectStillHeadStaysFinite({{StereoMode::Separate, RaySchedule::Auto, 0xff},
+                              {StereoMode::Gather, RaySchedule::Auto, 0xff},
+                              {StereoMode::Gather, RaySchedule::Auto, 0x3f},
+                              {StereoMode::Separate, RaySchedule::FirstHits, 0xff},
+                              {StereoMode::Gather, RaySchedule::Deferred, 0xff}});
+}
+
+// The open bug's reproduction, run on the device with --gtest_also_run_disabled_tests: the
+// reusing right eye's first hits apart and a listed pass over the pixels it does not reuse
+// (RaySchedule::FirstHits under gather, Auto's choice until 2026-12-07). On the H100 and the H200
+// it rendered 20-66 pixels, about one warp of the list, with a non-finite direct part in one to
+// four of every four 460-frame runs; a build whose listed kernel differed only in code after the
+// shading never did (docs/reliability.md).
+TEST(GpuBackend, DISABLED_TheListedRightEyePassStaysFinite) {
+  PVR_REQUIRE_GPU();
+  if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
+  expectStillHeadStaysFinite({{StereoMode::Gather, RaySchedule::FirstHits, 0xff},
+                              {StereoMode::Gather, RaySchedule::FirstHits, 0xff}});
 }
 
 // A rolling photon map (one slice of four retraced per frame, new numbers every frame) on both

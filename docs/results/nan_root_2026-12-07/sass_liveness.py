@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Registers (R, P, UR, UP) read before any write on some path of each SASS function from
 cuobjdump -sass (backward liveness at the function's entry). Calls are taken to clobber every
-register and read none; function live-ins beyond the ABI's argument registers are suspects.
-Usage: sass_liveness.py FILE.sass [NAME_PART] [-v]. Checked on a hand-written snippet only: its
-operand widths and multi-destination forms are a best effort, not yet run on a real dump."""
+register and read none, a predicated write kills nothing; function live-ins beyond the ABI's argument registers are suspects.
+Usage: sass_liveness.py FILE.sass [NAME_PART] [-v]. Run on the listed kernel's and an eye-rays
+kernel's real dump (H100, 2026-12-07, fifteenth session: none live at entry) after its first run
+there named UR7 and UR9, the upper halves of ULDC.64's destinations, which it now counts."""
 import os, re, sys
 from collections import defaultdict
 
@@ -70,10 +71,10 @@ def defs_uses(text):
     for i, o in enumerate(ops):
         is_pred = re.fullmatch(r'!?U?P(\d|T)', o) is not None
         if i == 0:
-            dw = w if base.startswith('LD') or base in ('DADD', 'DMUL', 'DFMA') else 1
+            dw = w if base.startswith(('LD', 'ULD')) or base in ('DADD', 'DMUL', 'DFMA') else 1
             if base.startswith('IMAD') and '.WIDE' in op: dw = 2
             if base in ('F2F', 'I2F', 'F2I') and '.F64' in op.split('.', 1)[1].split('.')[0:1] + ['']: dw = 2
-            if base == 'MOV' and '.64' in op: dw = 2
+            if base in ('MOV', 'UMOV') and '.64' in op: dw = 2
             defs.update(regs_in(o, dw))
         elif i < ndest or (not dest_done and is_pred and i <= 2 and base not in ('SEL', 'FSEL', 'VOTE', 'VOTEU', 'PLOP3') ):
             defs.update(regs_in(o))
@@ -138,7 +139,8 @@ def analyze(lines):
                     if r not in g: fu[r] = (addr, text)
                     g.add(r)
             if '*' in d: allk = True
-            k |= d
+            # A predicated write may not happen: it keeps the register's earlier value live.
+            if not re.match(r'^@!?U?P\d', text): k |= d
         gen.append(g); kill.append((k, allk)); first_use.append(fu)
     live = backward_live(gen, [k for k, _ in kill], succ, [allk for _, allk in kill])
     return blocks, live, first_use, succ
