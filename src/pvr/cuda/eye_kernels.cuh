@@ -16,6 +16,13 @@ __device__ inline bool tilePixel(int width, int height, int& x, int& y) {
 
 inline dim3 tileGrid(int width, int height) { return dim3(unsigned((width + kTile - 1) / kTile), unsigned((height + kTile - 1) / kTile)); }
 
+// Waits until every lane of the warp has finished shading, before a list kernel's stores; every
+// lane must call it (none may return before). ptxas 13.0 (sm_90) gave vertexRaysKernel's stores
+// the uniform registers that held the local frame's address, while lanes of the same warp that
+// lagged were still shading through it: their clipAtBoundaries read `params` out of bounds
+// (illegal address, foveated Sponza; docs/reliability.md).
+__device__ inline void finishShadingTogether() { __syncwarp(); }
+
 // Stores the sample's contribution: the running sum, scaled on the last sample (the CPU's order).
 __device__ inline void storeSample(Vec3* image, size_t pixel, Vec3 c, int sample, int samples) {
   Vec3 v = sample == 0 ? c : image[pixel] + c;

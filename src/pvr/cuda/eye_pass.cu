@@ -103,12 +103,16 @@ __global__ void __launch_bounds__(kTile* kTile, 6) listedEyeRaysKernel(SceneView
                                                                       const uint32_t* shadeList, const unsigned* shadeCount) {
   const SceneIntersector intersector = withSharedStack<kTile * kTile>(sceneIntersector);
   const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= *shadeCount) return;
-  const uint32_t pixel = shadeList[i];
-  const int x = int(pixel % unsigned(camera.width)), y = int(pixel / unsigned(camera.width));
-  PixelSample state;
-  const GatherPoint point =
-      pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, StereoReuseView(), state);
+  const bool shaded = i < *shadeCount;
+  const uint32_t pixel = shaded ? shadeList[i] : 0u;
+  GatherPoint point;
+  if (shaded) {
+    const int x = int(pixel % unsigned(camera.width)), y = int(pixel / unsigned(camera.width));
+    PixelSample state;
+    point = pixelGatherPoint(scene, intersector, params, camera, eye, x, y, sample, StereoReuseView(), state);
+  }
+  finishShadingTogether();
+  if (!shaded) return;
   points.store(pixel, point);
   recordGuide(out, pixel, point, sample, params.samplesPerPixel);
 }
@@ -289,9 +293,12 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
   }
   const bool deferred = pass.raySchedule == RaySchedule::Deferred;
   // A reusing right eye under gather whose first hits come from a pre-pass shades over a list of
-  // the pixels it does not reuse.
-  const bool listed = pass.role == StereoRole::Reuser && pass.reuse == StereoMode::Gather && !deferred &&
-                      !pass.foveated() && (params.primary.traced || params.primary.present());
+  // the pixels it does not reuse, where its schedule asks for first hits apart: Auto no longer
+  // does (frame_options.h), also under rasterised first hits, since the listed pass rendered
+  // non-finite pixels on some frames (docs/reliability.md).
+  const bool listed = pass.role == StereoRole::Reuser && pass.reuse == StereoMode::Gather &&
+                      pass.raySchedule == RaySchedule::FirstHits && !pass.foveated() &&
+                      (params.primary.traced || params.primary.present());
   if (listed) {
     shadeList_.reserve(pixels, "right-eye pixels to shade");
     shadeCount_.reserve(1, "right-eye pixels to shade");

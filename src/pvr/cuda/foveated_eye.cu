@@ -44,22 +44,25 @@ __global__ void vertexRaysKernel(SceneView scene, SceneIntersector sceneIntersec
                                  const uint32_t* listed, StereoReuseView reuse, EyeOutputs out, GatherPointStore points,
                                  float* inverseDepths) {
   const SceneIntersector intersector = withSharedStack<kVertexBlock>(sceneIntersector);
-  uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= *listed) return;
-  uint32_t vertex = list[i];
-  MaskPoint o = mask.offsets[vertex];
-  const float px = o.x + float(gazeX) + 0.5f, py = o.y + float(gazeY) + 0.5f;
-  if constexpr (R == StereoRole::Alone) {
-    float inverseDepth;  // a local: storing to global memory mid-path costs registers
-    points.store(vertex, imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, inverseDepth));
-    inverseDepths[vertex] = inverseDepth;
-  } else {
-    PixelSample sample;
-    points.store(vertex, vertexGatherPoint(scene, intersector, params, camera, eye, px, py, reuseFor<R>(reuse), sample,
-                                       R == StereoRole::Source ? out.surfaces : nullptr));
-    inverseDepths[vertex] = sample.inverseDepth;
-    if constexpr (R == StereoRole::Reuser) countInWarp(out.reusedCount, sample.reusedFrom != kNotReused);
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  const bool shaded = i < *listed;
+  const uint32_t vertex = shaded ? list[i] : 0u;
+  GatherPoint point;
+  PixelSample sample;  // the first hit's inverse depth; and the reuse decision
+  if (shaded) {
+    const MaskPoint o = mask.offsets[vertex];
+    const float px = o.x + float(gazeX) + 0.5f, py = o.y + float(gazeY) + 0.5f;
+    if constexpr (R == StereoRole::Alone)
+      point = imagePositionGatherPoint(scene, intersector, params, camera, eye, px, py, sample.inverseDepth);
+    else
+      point = vertexGatherPoint(scene, intersector, params, camera, eye, px, py, reuseFor<R>(reuse), sample,
+                                R == StereoRole::Source ? out.surfaces : nullptr);
   }
+  finishShadingTogether();
+  if (!shaded) return;
+  points.store(vertex, point);
+  inverseDepths[vertex] = sample.inverseDepth;
+  if constexpr (R == StereoRole::Reuser) countInWarp(out.reusedCount, sample.reusedFrom != kNotReused);
 }
 
 // `Lanes` threads per listed triangle, splitting its bounding box: the periphery's triangles
