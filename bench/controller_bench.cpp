@@ -18,6 +18,7 @@
 #include "pvr/app/options.h"
 #include "pvr/app/trajectory.h"
 #include "pvr/control/budget_controller.h"
+#include "pvr/foveation/gaze.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/image/image_compare.h"
 #include "pvr/reference/progressive_reference.h"
@@ -70,8 +71,7 @@ Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFr
   for (size_t f = 0; f < trajectory.size(); f += size_t(stride)) {
     rig.head = trajectory[f].head;
     RenderOptions o = choose(msSince(start));
-    std::copy(&trajectory[f].gaze[0][0], &trajectory[f].gaze[0][0] + 4, &o.foveation.gaze[0][0]);
-    o.foveation.verge = trajectory[f].verge;
+    copyGaze(trajectory[f], o.foveation);
     const auto frameStart = Clock::now();
     FrameResult frame = renderer.render(rig, o, false);
     const double ms = msSince(frameStart);

@@ -18,6 +18,7 @@
 #include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/cuda/cuda_frame_backend.h"
 #include "pvr/cuda/image_checks.h"
+#include "pvr/foveation/gaze.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/image/image_compare.h"
 #include "pvr/photon/kd_tree.h"
@@ -626,8 +627,7 @@ TEST(GpuBackend, AFoveatedWalkThroughSponzaRendersEveryFrame) {
   StereoRig rig = scene.rig;
   for (size_t f = 0; f < walk.size(); ++f) {
     rig.head = walk[f].head;
-    std::copy(&walk[f].gaze[0][0], &walk[f].gaze[0][0] + 4, &o.foveation.gaze[0][0]);
-    o.foveation.verge = walk[f].verge;
+    copyGaze(walk[f], o.foveation);
     try {
       gpu.render(rig, o, false);
     } catch (const Error& e) {

@@ -18,6 +18,7 @@
 
 #include "frame_bench.h"
 #include "pvr/app/options.h"
+#include "pvr/foveation/gaze.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/app/loop_commands.h"
 #include "pvr/app/soak.h"
@@ -493,8 +494,7 @@ int runRender(const RenderArgs& a) {
         decision = controller->decide(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         options = controller->optionsFor(decision->setting);
       }
-      std::copy(&trajectory[f].gaze[0][0], &trajectory[f].gaze[0][0] + 4, &options.foveation.gaze[0][0]);
-      options.foveation.verge = trajectory[f].verge;
+      copyGaze(trajectory[f], options.foveation);
       const auto frameStart = std::chrono::steady_clock::now();
       FrameResult frame = renderer->render(rig, options);
       if (controller) {  // the frame's time: the pipeline's, images read back

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pvr/foveation/gaze.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/loop/frame_loop.h"
 #include "pvr/loop/loop_keys.h"
@@ -40,8 +41,7 @@ std::vector<ScriptedView> scriptedPath(const std::vector<TrajectoryFrame>& traje
   for (const TrajectoryFrame& t : trajectory) {
     ScriptedView v;
     v.head = t.head;
-    std::copy(&t.gaze[0][0], &t.gaze[0][0] + 4, &v.gaze[0][0]);
-    v.verge = t.verge;
+    copyGaze(t, v);
     path.push_back(v);
   }
   return path;
@@ -243,7 +243,7 @@ int runXrCommand(const LoopCommandArgs& args, const LoopSetup& setup) {
     xo.nearZ = args.nearZ;
     xo.stageSpace = args.stage;
     xo.sceneFromSpace = setup.rig.head;  // the reference space's origin is the scene's viewpoint
-    std::copy(&setup.options.foveation.gaze[0][0], &setup.options.foveation.gaze[0][0] + 4, &xo.gaze[0][0]);
+    copyGaze(setup.options.foveation, xo);
     xo.exposure = args.exposure;
     xo.gpuImages = renderer.backendName() == "cuda";
     xo.readyTimeoutSeconds = args.readyTimeout;

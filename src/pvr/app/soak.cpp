@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 
+#include "pvr/foveation/gaze.h"
 #include "pvr/foveation/mask.h"
 #include "pvr/image/image_compare.h"
 #include "pvr/loop/frame_loop.h"
@@ -124,8 +125,7 @@ class SoakPresenter : public Presenter {
     if (!path_.empty()) {
       const ScriptedView& v = path_[frame_ % path_.size()];
       request.rig.head = v.head;
-      std::copy(&v.gaze[0][0], &v.gaze[0][0] + 4, &request.gaze[0][0]);
-      request.verge = v.verge;
+      copyGaze(v, request);
     }
     request.shouldRender = true;
     request.deadline.reset();
@@ -193,8 +193,7 @@ std::vector<ScriptedView> soakPath(const LoopSetup& setup) {
   for (const TrajectoryFrame& t : setup.trajectory) {
     ScriptedView v;
     v.head = t.head;
-    std::copy(&t.gaze[0][0], &t.gaze[0][0] + 4, &v.gaze[0][0]);
-    v.verge = t.verge;
+    copyGaze(t, v);
     path.push_back(v);
   }
   if (!path.empty()) return path;

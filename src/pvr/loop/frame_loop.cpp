@@ -1,5 +1,7 @@
 #include "pvr/loop/frame_loop.h"
 
+#include "pvr/foveation/gaze.h"
+
 namespace pvr {
 namespace {
 
@@ -51,8 +53,7 @@ FrameStats FrameLoop::run(const FrameLoopOptions& options) {
       continue;
     }
     renderer_.rig() = request.rig;
-    renderer_.options().foveation.verge = request.verge;
-    std::copy(&request.gaze[0][0], &request.gaze[0][0] + 4, &renderer_.options().foveation.gaze[0][0]);
+    copyGaze(request, renderer_.options().foveation);
     FrameResult frame = renderer_.renderFrame(request.rig.head, nullptr, output);
     LoopClock::time_point rendered_at = LoopClock::now();
     presenter_.present({request, &frame, renderer_, output == FrameOutput::DeviceBuffers});

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <thread>
 
+#include "pvr/foveation/gaze.h"
 #include "pvr/util/error.h"
 
 namespace pvr {
@@ -32,8 +33,7 @@ bool OffscreenPresenter::waitFrame(FrameRequest& request) {
   if (!path_.empty()) {
     const ScriptedView& view = path_[frame_ % path_.size()];
     request.rig.head = view.head;
-    std::copy(&view.gaze[0][0], &view.gaze[0][0] + 4, &request.gaze[0][0]);
-    request.verge = view.verge;
+    copyGaze(view, request);
   }
   request.shouldRender = true;
   request.deadline = slot + period_;

@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "pvr/foveation/gaze.h"
 #include "pvr/loop/loop_keys.h"
 #include "pvr/util/error.h"
 #include "pvr/vk/eye_transfer.h"
@@ -570,8 +571,7 @@ bool XrPresenter::waitFrame(FrameRequest& request) {
   request.shouldRender = m.frameState.shouldRender && m.viewsValid;
   if (m.viewsValid) request.rig = rigFromViews(m.views, m.options.sceneFromSpace, m.width, m.height);
   request.rig.width = m.width, request.rig.height = m.height;
-  std::copy(&m.options.gaze[0][0], &m.options.gaze[0][0] + 4, &request.gaze[0][0]);
-  request.verge = m.options.verge;
+  copyGaze(m.options, request);
   request.gazeTracked = false;
   ++m.frames;
   XrResult synced = XR_SESSION_NOT_FOCUSED;
