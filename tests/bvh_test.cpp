@@ -119,6 +119,39 @@ void expectWatertightSphere() {
   EXPECT_EQ(misses, 0u) << "of " << rays << " rays through shared edges and vertices";
 }
 
+// Triangles nested towards a corner, each 0.85 times the last: input that asks for a deep tree
+// (Embree's build makes it 22 levels deep; a chain would be 150). The build keeps within the
+// traversal stack, which has no bound check, and a ray just under each triangle finds it.
+TEST(Bvh, ANestOfShrinkingTrianglesStaysWithinTheTraversalStack) {
+  // 150: the smallest is 3e-11 across, and the triangle test's products (cubes of the size) stay
+  // normal floats.
+  constexpr uint32_t kTriangles = 150;
+  std::vector<Vec3> v;
+  std::vector<uint32_t> idx;
+  std::vector<float> size;
+  float s = 1.0f;
+  for (uint32_t k = 0; k < kTriangles; ++k, s *= 0.85f) {
+    for (Vec3 p : {Vec3{s, 0.0f, s}, Vec3{0.0f, s, s}, Vec3{s, s, s}}) {
+      idx.push_back(uint32_t(v.size()));
+      v.push_back(p);
+    }
+    size.push_back(s);
+  }
+  Bvh bvh = Bvh::build(v, idx);
+  EXPECT_GT(bvh.stats().maxDepth, 16u);  // a deep tree: the case the bound is for
+  EXPECT_LE(bvh.stats().maxDepth, uint32_t(BvhIntersector::kStackSize));
+  BvhIntersector ours{bvh.view()};
+  for (uint32_t k = 0; k < kTriangles; ++k) {
+    // Inside triangle k, above every smaller one (they lie at 0.85 s and below).
+    Ray ray{{0.9f * size[k], 0.9f * size[k], 0.99f * size[k]}, {0.0f, 0.0f, 1.0f}};
+    Hit h;
+    ASSERT_TRUE(ours.intersect(ray, INFINITY, h)) << "triangle " << k;
+    EXPECT_EQ(h.primId, k);
+    EXPECT_TRUE(ours.occluded(ray, 0.02f * size[k])) << "triangle " << k;
+    EXPECT_FALSE(ours.occluded(ray, 0.005f * size[k])) << "triangle " << k;
+  }
+}
+
 TEST(Bvh, WatertightAtSharedEdgesAndVertices) { expectWatertightSphere<Bvh, BvhIntersector>(); }
 
 // The wide BVH: the same hits as Embree and as the binary BVH, the same watertightness, and boxes

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <string>
 
+#include "pvr/accel/bvh_traversal.h"
 #include "pvr/accel/wide_bvh.h"
 #include "pvr/accel/wide_bvh_traversal.h"
 
@@ -143,6 +144,9 @@ class Flattener {
  private:
   void fillInner(uint32_t index, const BuildInner* node, uint32_t depth) {
     stats_.maxDepth = std::max(stats_.maxDepth, depth);
+    // A traversal pushes at most one entry per inner node on its path; its stack has no bound check.
+    if (depth > uint32_t(BvhIntersector::kStackSize))
+      throw Error("the BVH is deeper than its traversal stack: " + std::to_string(depth));
     for (int c = 0; c < 2; ++c) {
       if (node->children[c]) setChild(index, c, node->children[c], node->bounds[c], depth + 1);
       else setEmpty(index, c);
