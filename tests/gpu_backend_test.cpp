@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <string>
 #include <utility>
 
 #include "gpu_ray_throughput.h"
@@ -436,6 +437,21 @@ struct StillHeadRun {
   int fill;
 };
 
+// Dabrovic Sponza through scenes/dabrovic-sponza.json, or why not (PVR_SCENES unset, the mesh
+// missing there): the tests that walk it skip with that reason.
+std::optional<Scene> loadSponza(std::string& whyNot) {
+  if (!std::getenv("PVR_SCENES")) {
+    whyNot = "PVR_SCENES is not set (Dabrovic Sponza)";
+    return std::nullopt;
+  }
+  try {
+    return loadScene("scenes/dabrovic-sponza.json");
+  } catch (const Error& e) {
+    whyNot = e.what();
+    return std::nullopt;
+  }
+}
+
 // A still head refining for 5 s (450 frames) at the quality bench's settings on Dabrovic Sponza,
 // both eyes at full resolution, in memory left dirty, images left on the GPU as the bench leaves
 // them, for each run: no pixel of any frame is non-finite (counted on the GPU every frame).
@@ -443,12 +459,10 @@ struct StillHeadRun {
 // (else the denoiser made them), the first such pixel, its direct part, the map's photons, and
 // the right eye's first bad pixel's gather point with its estimate redone on the host.
 void expectStillHeadStaysFinite(const std::vector<StillHeadRun>& runs) {
-  Scene scene;
-  try {
-    scene = loadScene("scenes/dabrovic-sponza.json");
-  } catch (const Error& e) {
-    GTEST_SKIP() << e.what();
-  }
+  std::string whyNot;
+  std::optional<Scene> sponza = loadSponza(whyNot);
+  if (!sponza) GTEST_SKIP() << whyNot;
+  Scene& scene = *sponza;
   const size_t pixels = size_t(scene.rig.width) * size_t(scene.rig.height);
   for (const auto& [stereo, schedule, fill] : runs) {
     dirtyFreeDeviceMemory(fill);
@@ -575,7 +589,6 @@ void expectStillHeadStaysFinite(const std::vector<StillHeadRun>& runs) {
 // keeps the reusing right eye's rays in its eye kernel. Needs PVR_SCENES (skipped without).
 TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
   PVR_REQUIRE_GPU();
-  if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
   expectStillHeadStaysFinite({{StereoMode::Separate, RaySchedule::Auto, 0xff},
                               {StereoMode::Gather, RaySchedule::Auto, 0xff},
                               {StereoMode::Gather, RaySchedule::Auto, 0x3f},
@@ -591,7 +604,6 @@ TEST(GpuBackend, ARefiningStillHeadUnderGatherReuseStaysFinite) {
 // shading never did (docs/reliability.md).
 TEST(GpuBackend, DISABLED_TheListedRightEyePassStaysFinite) {
   PVR_REQUIRE_GPU();
-  if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
   expectStillHeadStaysFinite({{StereoMode::Gather, RaySchedule::FirstHits, 0xff},
                               {StereoMode::Gather, RaySchedule::FirstHits, 0xff}});
 }
@@ -604,13 +616,10 @@ TEST(GpuBackend, DISABLED_TheListedRightEyePassStaysFinite) {
 // and none has a non-finite pixel. Needs PVR_SCENES (skipped without).
 TEST(GpuBackend, AFoveatedWalkThroughSponzaRendersEveryFrame) {
   PVR_REQUIRE_GPU();
-  if (!std::getenv("PVR_SCENES")) GTEST_SKIP() << "PVR_SCENES is not set (Dabrovic Sponza)";
-  Scene scene;
-  try {
-    scene = loadScene("scenes/dabrovic-sponza.json");
-  } catch (const Error& e) {
-    GTEST_SKIP() << e.what();
-  }
+  std::string whyNot;
+  std::optional<Scene> sponza = loadSponza(whyNot);
+  if (!sponza) GTEST_SKIP() << whyNot;
+  Scene& scene = *sponza;
   const std::vector<TrajectoryFrame> walk = loadTrajectory(std::string(PVR_TEST_DATA) + "/sponza_walk_every9.traj");
   ASSERT_EQ(walk.size(), 190u);
   const FoveationMask mask = generateFoveationMask(maskParamsForRig(scene.rig));
