@@ -851,6 +851,60 @@ FrameRays countFrameRays(const Scene& scene, const StereoRig& rig, const RenderO
   return rays;
 }
 
+#ifdef PVR_HAVE_CUDA
+// The photon pass's rays per second beside the ray kernels' (the rays suite's table above), at
+// growing photon counts. At a frame's 512^2 the pass waits on its longest paths (the GPU is not
+// filled), so its rate per ray follows how many rays a scene's paths cast; from 1024^2 it fills
+// the GPU and the rate is that of its traversal and shading.
+int runPhotonTraceRates(const FrameBenchArgs& args, nlohmann::json& json) {
+  const int repeats = 20;
+  std::printf("\nPhoton pass (trace, scan of the counts, compaction: a frame's trace stage), full shading's photons "
+              "(no direct photons stored), up to 8 interactions a path; %d runs each (CUDA events; after a warm-up "
+              "run). Rays: the paths' segments, counted on the CPU by the same code; stored photons GPU against CPU "
+              "(the same paths but for rounding: within 0.1 %%)\n\n"
+              "| scene | photons | rays (per photon) | stored GPU / CPU | pass ms (median / p99) | Mrays/s (median / p99) | "
+              "check |\n|---|---|---|---|---|---|---|\n",
+              repeats);
+  int failures = 0;
+  for (const std::string& name : splitList(args.raysScene)) {
+    Scene scene = loadScene(name);
+    CudaFrameBackend gpu(scene);
+    CpuBackend cpu(scene);
+    const SceneView view = scene.view();
+    for (uint32_t side : {256u, 512u, 1024u, 2048u}) {
+      RenderOptions o;
+      o.photonsX = o.photonsY = side;
+      o.gather.mode = ShadingMode::Full;
+      const PhotonTraceParams tp = o.photonTraceParams();
+      CountingIntersector counter{cpu.intersector()};
+      std::atomic<uint64_t> cpuStored{0};
+      parallelFor("count photon rays", tp.photonCount, 4096, [&](size_t begin, size_t end) {
+        std::vector<Photon> buffer(size_t(tp.maxDepth));
+        uint64_t stored = 0;
+        for (size_t i = begin; i < end; ++i) stored += uint64_t(tracePhoton(view, counter, tp, uint32_t(i), buffer.data()));
+        cpuStored += stored;
+      });
+      const uint64_t rays = counter.closest + counter.shadow;
+      size_t gpuStored = 0;
+      const LatencyStats t = latencyStats(timePhotonTrace(gpu, tp, repeats, gpuStored));
+      const double storedRatio = cpuStored ? double(gpuStored) / double(cpuStored.load()) : (gpuStored ? 2.0 : 1.0);
+      const bool ok = std::fabs(storedRatio - 1.0) <= 1e-3;
+      failures += ok ? 0 : 1;
+      auto mrays = [&](double ms) { return ms > 0 ? double(rays) / (ms * 1e3) : 0.0; };
+      std::printf("| %s | %ux%u | %.2f M (%.2f) | %zu / %llu | %.3f / %.3f | %.0f / %.0f | %s |\n", name.c_str(), side,
+                  side, rays * 1e-6, double(rays) / double(tp.photonCount), gpuStored,
+                  (unsigned long long)cpuStored.load(), t.p50, t.p99, mrays(t.p50), mrays(t.p99), ok ? "ok" : "MISMATCH");
+      std::fflush(stdout);
+      json.push_back({{"suite", "rays"}, {"stage", "photon pass"}, {"scene", name}, {"photons", tp.photonCount},
+                      {"max_depth", tp.maxDepth}, {"rays", rays}, {"stored_gpu", gpuStored},
+                      {"stored_cpu", cpuStored.load()}, {"repeats", repeats}, {"pass", t},
+                      {"mrays_s", mrays(t.p50)}, {"p99_mrays_s", mrays(t.p99)}, {"check", ok ? "ok" : "MISMATCH"}});
+    }
+  }
+  return failures;
+}
+#endif
+
 // Textured scenes with full shading (the real-time configuration): separate and gather frames,
 // the same gather frame without colour textures (what sampling costs), and each image's error
 // against the view's converged reference (progressive photon mapping from the cells' radius,
@@ -1041,7 +1095,7 @@ int runFrameBench(const FrameBenchArgs& args) {
   if (args.suite == "effects") failures += runEffects(args, kind, json);
   if (args.suite == "controller") failures += runControllerBench(args, kind, json);
 #ifdef PVR_HAVE_CUDA
-  if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json);
+  if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json) + runPhotonTraceRates(args, json);
   if (args.suite == "grid" || args.suite == "all") failures += runGrid(args, json);
 #endif
   if (!args.json.empty()) {

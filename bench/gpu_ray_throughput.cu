@@ -176,4 +176,20 @@ GpuRayThroughput GpuRayBench::measure(const StereoRig& rig, int repeats, bool sh
                      : measureRays<BvhIntersector, false>(m.backend, m.binary, rig, repeats);
 }
 
+std::vector<double> timePhotonTrace(CudaFrameBackend& backend, const PhotonTraceParams& params, int repeats,
+                                    size_t& stored) {
+  PVR_CUDA_CHECK(cudaDeviceSynchronize());
+  cudaStream_t stream = backend.stream();
+  EventTimer timer;
+  std::vector<double> ms;
+  for (int r = -1; r < repeats; ++r) {  // r = -1 warms up (and sizes the tracer's buffers)
+    timer.start(stream);
+    stored = backend.tracePhotons(params, 0, 1);
+    timer.stop(stream);
+    const double t = timer.ms();
+    if (r >= 0) ms.push_back(t);
+  }
+  return ms;
+}
+
 }  // namespace pvr

@@ -35,4 +35,10 @@ class GpuRayBench {
   std::unique_ptr<Impl> impl_;
 };
 
+// The photon pass alone, as a frame runs it (CudaFrameBackend::tracePhotons: the paths, the scan
+// of their counts and the compaction), timed with CUDA events over `repeats` runs after one
+// warm-up run: each run's milliseconds. `stored` receives the photons the last run stored.
+std::vector<double> timePhotonTrace(CudaFrameBackend& backend, const PhotonTraceParams& params, int repeats,
+                                    size_t& stored);
+
 }  // namespace pvr
