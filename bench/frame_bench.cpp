@@ -667,8 +667,8 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
               "after its own warm-up run): Mrays/s at the median run time / at the p99 run time (p99 by nearest "
               "rank: the slowest under 100 runs). Two BVH layouts, both built by Embree (SAH + spatial splits), "
               "both with the same watertight triangle test: binary (64-byte nodes, 4 triangles a leaf) and "
-              "8-wide with 8-bit quantized child boxes (80-byte nodes, 3 triangles a leaf; the renderer's); the "
-              "traversal stack in shared memory (the renderer's) or in local memory\n\n"
+              "8-wide with 8-bit quantized child boxes (80-byte nodes, 3 triangles a leaf); the renderer's kernels "
+              "use the binary one; the traversal stack in shared memory (the renderer's) or in local memory\n\n"
               "| scene | triangles | BVH | nodes | refs | MiB | build ms | SAH cost | eye size | primary Mrays/s "
               "(median / p99) | shadow Mrays/s (median / p99) | diffuse Mrays/s (median / p99) | check vs Embree |\n"
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -861,7 +861,8 @@ int runPhotonTraceRates(const FrameBenchArgs& args, nlohmann::json& json) {
   std::printf("\nPhoton pass (trace, scan of the counts, compaction: a frame's trace stage), full shading's photons "
               "(no direct photons stored), up to 8 interactions a path; %d runs each (CUDA events; after a warm-up "
               "run). Rays: the paths' segments, counted on the CPU by the same code; stored photons GPU against CPU "
-              "(the same paths but for rounding: within 0.1 %%)\n\n"
+              "(the same paths but for rounding, which may tip a few: they differ by at most 0.1 %% of the emitted "
+              "photons)\n\n"
               "| scene | photons | rays (per photon) | stored GPU / CPU | pass ms (median / p99) | Mrays/s (median / p99) | "
               "check |\n|---|---|---|---|---|---|---|\n",
               repeats);
@@ -887,8 +888,8 @@ int runPhotonTraceRates(const FrameBenchArgs& args, nlohmann::json& json) {
       const uint64_t rays = counter.closest + counter.shadow;
       size_t gpuStored = 0;
       const LatencyStats t = latencyStats(timePhotonTrace(gpu, tp, repeats, gpuStored));
-      const double storedRatio = cpuStored ? double(gpuStored) / double(cpuStored.load()) : (gpuStored ? 2.0 : 1.0);
-      const bool ok = std::fabs(storedRatio - 1.0) <= 1e-3;
+      const double storedDifference = std::fabs(double(gpuStored) - double(cpuStored.load()));
+      const bool ok = storedDifference <= 1e-3 * double(tp.photonCount);
       failures += ok ? 0 : 1;
       auto mrays = [&](double ms) { return ms > 0 ? double(rays) / (ms * 1e3) : 0.0; };
       std::printf("| %s | %ux%u | %.2f M (%.2f) | %zu / %llu | %.3f / %.3f | %.0f / %.0f | %s |\n", name.c_str(), side,

@@ -293,9 +293,9 @@ void GpuEyePass::render(const DeviceScene& scene, DeviceMap map, const EyePass& 
   }
   const bool deferred = pass.raySchedule == RaySchedule::Deferred;
   // A reusing right eye under gather whose first hits come from a pre-pass shades over a list of
-  // the pixels it does not reuse, where its schedule asks for first hits apart: Auto no longer
-  // does (frame_options.h), also under rasterised first hits, since the listed pass rendered
-  // non-finite pixels on some frames (docs/reliability.md).
+  // the pixels it does not reuse, where its schedule asks for first hits apart (Auto's choice
+  // from two shadow queries a point, frame_options.h), with traced and rasterised first hits
+  // alike.
   const bool listed = pass.role == StereoRole::Reuser && pass.reuse == StereoMode::Gather &&
                       pass.raySchedule == RaySchedule::FirstHits && !pass.foveated() &&
                       (params.primary.traced || params.primary.present());

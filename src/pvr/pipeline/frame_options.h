@@ -56,14 +56,13 @@ const char* rayScheduleName(RaySchedule s);  ///< "auto" | "in-kernel" | "first-
 // Auto's choice for an eye pass whose gather points ask `shadowQueries` shadow rays each: kernels
 // of their own pay where a point asks several (the eye kernel's registers then hold up more rays:
 // measured 2026-12-05 on the H100, docs/benchmarks.md), not where it asks one (cornell-dense's
-// area light). A right eye that reuses the left's shading keeps its rays in its eye kernel: its
-// first hits apart and a listed pass over the pixels it does not reuse (FirstHits under gather)
-// were 0.6-1.2 ms a stereo frame faster on the cathedrals, but rendered about one warp of pixels
-// with a non-finite direct part in some still frames on the H100 and H200, cause not found
-// (docs/reliability.md; GpuBackend.DISABLED_TheListedRightEyePassStaysFinite).
+// area light). A right eye that reuses the left's shading shades few pixels: no deferral there;
+// with first hits apart it shades over a list of the pixels it does not reuse (0.6-1.2 ms a
+// stereo frame faster on the cathedrals than in-kernel). That listed pass's non-finite pixels
+// (2026-12-06/07) were ptxas's uniform registers reloaded under lagging lanes, avoided since
+// a30ef05 (finishShadingTogether; docs/reliability.md).
 inline RaySchedule eyeRayScheduleFor(int shadowQueries, bool reuser) {
-  if (reuser) return RaySchedule::InKernel;
-  if (shadowQueries >= 3) return RaySchedule::Deferred;
+  if (shadowQueries >= 3 && !reuser) return RaySchedule::Deferred;
   if (shadowQueries >= 2) return RaySchedule::FirstHits;
   return RaySchedule::InKernel;
 }
