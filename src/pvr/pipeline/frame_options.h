@@ -59,8 +59,8 @@ const char* rayScheduleName(RaySchedule s);  ///< "auto" | "in-kernel" | "first-
 // area light). A right eye that reuses the left's shading shades few pixels: no deferral there;
 // with first hits apart it shades over a list of the pixels it does not reuse (0.6-1.2 ms a
 // stereo frame faster on the cathedrals than in-kernel). That listed pass's non-finite pixels
-// (2026-12-06/07) were ptxas's uniform registers reloaded under lagging lanes, avoided since
-// a30ef05 (finishShadingTogether; docs/reliability.md).
+// (2026-12-06/07) stopped with a30ef05's workaround for the compiler fault found in the foveated
+// pass (finishShadingTogether; docs/reliability.md).
 inline RaySchedule eyeRayScheduleFor(int shadowQueries, bool reuser) {
   if (shadowQueries >= 3 && !reuser) return RaySchedule::Deferred;
   if (shadowQueries >= 2) return RaySchedule::FirstHits;
