@@ -36,6 +36,39 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
+// Rays a frame casts, counted on the CPU by the shared algorithm code over a counting Embree
+// intersector: every backend casts the same rays (the GPU is checked against the CPU), so
+// dividing by a backend's stage times gives its rays per second.
+struct CountingIntersector {
+  const EmbreeIntersector& inner;
+  mutable std::atomic<uint64_t> closest{0}, shadow{0};
+  bool intersect(const Ray& ray, float tMax, Hit& hit) const {
+    closest.fetch_add(1, std::memory_order_relaxed);
+    return inner.intersect(ray, tMax, hit);
+  }
+  bool occluded(const Ray& ray, float tMax) const {
+    shadow.fetch_add(1, std::memory_order_relaxed);
+    return inner.occluded(ray, tMax);
+  }
+};
+
+// Photon paths traced on the CPU by the shared code: their segments (rays) and stored photons.
+struct PhotonPaths {
+  uint64_t rays = 0, stored = 0;
+};
+PhotonPaths countPhotonPaths(const SceneView& view, const EmbreeIntersector& intersector, const PhotonTraceParams& tp) {
+  CountingIntersector counter{intersector};
+  std::atomic<uint64_t> stored{0};
+  parallelFor("count photon rays", tp.photonCount, 4096, [&](size_t begin, size_t end) {
+    std::vector<Photon> buffer(size_t(tp.maxDepth));
+    uint64_t count = 0;
+    for (size_t i = begin; i < end; ++i) count += uint64_t(tracePhoton(view, counter, tp, uint32_t(i), buffer.data()));
+    stored += count;
+  });
+  return {counter.closest + counter.shadow, stored.load()};
+}
+
+
 // One column of one of the paper's tables.
 struct Variant {
   std::string name;
@@ -660,9 +693,42 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
 }
 
 #ifdef PVR_HAVE_CUDA
+// The photon pass's rays per second beside the ray kernels' (the rays suite), at growing photon
+// counts: a row each, returned for the table after the rays'. At a frame's 512^2 the pass waits on
+// its longest paths (the GPU is not filled), so its rate per ray follows how many rays a scene's
+// paths cast; from 1024^2 it fills the GPU and the rate is that of its traversal and shading.
+std::string photonPassRows(const std::string& name, const Scene& scene, CudaFrameBackend& gpu, const CpuBackend& cpu,
+                           int repeats, nlohmann::json& json, int& failures) {
+  std::string rows;
+  for (uint32_t side : {256u, 512u, 1024u, 2048u}) {
+    RenderOptions o;
+    o.photonsX = o.photonsY = side;
+    o.gather.mode = ShadingMode::Full;
+    const PhotonTraceParams tp = o.photonTraceParams();
+    const PhotonPaths paths = countPhotonPaths(scene.view(), cpu.intersector(), tp);
+    size_t gpuStored = 0;
+    const LatencyStats t = latencyStats(timePhotonTrace(gpu, tp, repeats, gpuStored));
+    const double storedDifference = std::fabs(double(gpuStored) - double(paths.stored));
+    const bool ok = storedDifference <= 1e-3 * double(tp.photonCount);
+    failures += ok ? 0 : 1;
+    auto mrays = [&](double ms) { return ms > 0 ? double(paths.rays) / (ms * 1e3) : 0.0; };
+    char row[512];
+    std::snprintf(row, sizeof row, "| %s | %ux%u | %.2f M (%.2f) | %zu / %llu | %.3f / %.3f | %.0f / %.0f | %s |\n",
+                  name.c_str(), side, side, paths.rays * 1e-6, double(paths.rays) / double(tp.photonCount), gpuStored,
+                  (unsigned long long)paths.stored, t.p50, t.p99, mrays(t.p50), mrays(t.p99), ok ? "ok" : "MISMATCH");
+    rows += row;
+    json.push_back({{"suite", "rays"}, {"stage", "photon pass"}, {"scene", name}, {"photons", tp.photonCount},
+                    {"max_depth", tp.maxDepth}, {"rays", paths.rays}, {"stored_gpu", gpuStored},
+                    {"stored_cpu", paths.stored}, {"repeats", repeats}, {"pass", t}, {"mrays_s", mrays(t.p50)},
+                    {"p99_mrays_s", mrays(t.p99)}, {"check", ok ? "ok" : "MISMATCH"}});
+  }
+  return rows;
+}
+
 int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
   int failures = 0;
   const int repeats = 20;
+  std::string photonRows;  // the photon pass's table, printed after the rays'
   std::printf("\nRay throughput of the CUDA traversal, both eyes, one ray per pixel, %d runs (CUDA events; each "
               "after its own warm-up run): Mrays/s at the median run time / at the p99 run time (p99 by nearest "
               "rank: the slowest under 100 runs). Two BVH layouts, both built by Embree (SAH + spatial splits), "
@@ -734,7 +800,16 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
                       {"shadow", shadow}, {"diffuse", diffuse}, {"check_agreement", agreement}});
       std::fflush(stdout);
     }
+    photonRows += photonPassRows(name, scene, gpu, cpu, repeats, json, failures);
   }
+  std::printf("\nPhoton pass (trace, scan of the counts, compaction: a frame's trace stage), full shading's photons "
+              "(no direct photons stored), up to 8 interactions a path; %d runs each (CUDA events; after a warm-up "
+              "run). Rays: the paths' segments, counted on the CPU by the same code; stored photons GPU against CPU "
+              "(the same paths but for rounding, which may tip a few: they differ by at most 0.1 %% of the emitted "
+              "photons)\n\n"
+              "| scene | photons | rays (per photon) | stored GPU / CPU | pass ms (median / p99) | Mrays/s (median / p99) | "
+              "check |\n|---|---|---|---|---|---|---|\n%s",
+              repeats, photonRows.c_str());
   return failures;
 }
 
@@ -804,22 +879,6 @@ int runGrid(const FrameBenchArgs& args, nlohmann::json& json) {
 
 }  // namespace
 
-// Rays a frame casts, counted on the CPU by the shared algorithm code over a counting Embree
-// intersector: every backend casts the same rays (the GPU is checked against the CPU), so
-// dividing by a backend's stage times gives its rays per second.
-struct CountingIntersector {
-  const EmbreeIntersector& inner;
-  mutable std::atomic<uint64_t> closest{0}, shadow{0};
-  bool intersect(const Ray& ray, float tMax, Hit& hit) const {
-    closest.fetch_add(1, std::memory_order_relaxed);
-    return inner.intersect(ray, tMax, hit);
-  }
-  bool occluded(const Ray& ray, float tMax) const {
-    shadow.fetch_add(1, std::memory_order_relaxed);
-    return inner.occluded(ray, tMax);
-  }
-};
-
 struct FrameRays {
   uint64_t photon = 0;  ///< photon paths' segments
   uint64_t eye = 0;     ///< both eyes: camera and specular-chain rays plus shadow rays
@@ -830,13 +889,7 @@ FrameRays countFrameRays(const Scene& scene, const StereoRig& rig, const RenderO
   CpuBackend backend(scene);
   SceneView view = scene.view();
   FrameRays rays;
-  CountingIntersector photonCounter{backend.intersector()};
-  const PhotonTraceParams tp = o.photonTraceParams();
-  parallelFor("count photon rays", tp.photonCount, 4096, [&](size_t begin, size_t end) {
-    std::vector<Photon> buffer(size_t(tp.maxDepth));
-    for (size_t i = begin; i < end; ++i) tracePhoton(view, photonCounter, tp, uint32_t(i), buffer.data());
-  });
-  rays.photon = photonCounter.closest + photonCounter.shadow;
+  rays.photon = countPhotonPaths(view, backend.intersector(), o.photonTraceParams()).rays;
   // Eye paths never depend on the photon map's contents: an empty one casts the same rays.
   HashGrid grid = HashGrid::build({}, o.gather.density.radius);
   CountingIntersector eyeCounter{backend.intersector()};
@@ -851,60 +904,6 @@ FrameRays countFrameRays(const Scene& scene, const StereoRig& rig, const RenderO
   return rays;
 }
 
-#ifdef PVR_HAVE_CUDA
-// The photon pass's rays per second beside the ray kernels' (the rays suite's table above), at
-// growing photon counts. At a frame's 512^2 the pass waits on its longest paths (the GPU is not
-// filled), so its rate per ray follows how many rays a scene's paths cast; from 1024^2 it fills
-// the GPU and the rate is that of its traversal and shading.
-int runPhotonTraceRates(const FrameBenchArgs& args, nlohmann::json& json) {
-  const int repeats = 20;
-  std::printf("\nPhoton pass (trace, scan of the counts, compaction: a frame's trace stage), full shading's photons "
-              "(no direct photons stored), up to 8 interactions a path; %d runs each (CUDA events; after a warm-up "
-              "run). Rays: the paths' segments, counted on the CPU by the same code; stored photons GPU against CPU "
-              "(the same paths but for rounding, which may tip a few: they differ by at most 0.1 %% of the emitted "
-              "photons)\n\n"
-              "| scene | photons | rays (per photon) | stored GPU / CPU | pass ms (median / p99) | Mrays/s (median / p99) | "
-              "check |\n|---|---|---|---|---|---|---|\n",
-              repeats);
-  int failures = 0;
-  for (const std::string& name : splitList(args.raysScene)) {
-    Scene scene = loadScene(name);
-    CudaFrameBackend gpu(scene);
-    CpuBackend cpu(scene);
-    const SceneView view = scene.view();
-    for (uint32_t side : {256u, 512u, 1024u, 2048u}) {
-      RenderOptions o;
-      o.photonsX = o.photonsY = side;
-      o.gather.mode = ShadingMode::Full;
-      const PhotonTraceParams tp = o.photonTraceParams();
-      CountingIntersector counter{cpu.intersector()};
-      std::atomic<uint64_t> cpuStored{0};
-      parallelFor("count photon rays", tp.photonCount, 4096, [&](size_t begin, size_t end) {
-        std::vector<Photon> buffer(size_t(tp.maxDepth));
-        uint64_t stored = 0;
-        for (size_t i = begin; i < end; ++i) stored += uint64_t(tracePhoton(view, counter, tp, uint32_t(i), buffer.data()));
-        cpuStored += stored;
-      });
-      const uint64_t rays = counter.closest + counter.shadow;
-      size_t gpuStored = 0;
-      const LatencyStats t = latencyStats(timePhotonTrace(gpu, tp, repeats, gpuStored));
-      const double storedDifference = std::fabs(double(gpuStored) - double(cpuStored.load()));
-      const bool ok = storedDifference <= 1e-3 * double(tp.photonCount);
-      failures += ok ? 0 : 1;
-      auto mrays = [&](double ms) { return ms > 0 ? double(rays) / (ms * 1e3) : 0.0; };
-      std::printf("| %s | %ux%u | %.2f M (%.2f) | %zu / %llu | %.3f / %.3f | %.0f / %.0f | %s |\n", name.c_str(), side,
-                  side, rays * 1e-6, double(rays) / double(tp.photonCount), gpuStored,
-                  (unsigned long long)cpuStored.load(), t.p50, t.p99, mrays(t.p50), mrays(t.p99), ok ? "ok" : "MISMATCH");
-      std::fflush(stdout);
-      json.push_back({{"suite", "rays"}, {"stage", "photon pass"}, {"scene", name}, {"photons", tp.photonCount},
-                      {"max_depth", tp.maxDepth}, {"rays", rays}, {"stored_gpu", gpuStored},
-                      {"stored_cpu", cpuStored.load()}, {"repeats", repeats}, {"pass", t},
-                      {"mrays_s", mrays(t.p50)}, {"p99_mrays_s", mrays(t.p99)}, {"check", ok ? "ok" : "MISMATCH"}});
-    }
-  }
-  return failures;
-}
-#endif
 
 // Textured scenes with full shading (the real-time configuration): separate and gather frames,
 // the same gather frame without colour textures (what sampling costs), and each image's error
@@ -1096,7 +1095,7 @@ int runFrameBench(const FrameBenchArgs& args) {
   if (args.suite == "effects") failures += runEffects(args, kind, json);
   if (args.suite == "controller") failures += runControllerBench(args, kind, json);
 #ifdef PVR_HAVE_CUDA
-  if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json) + runPhotonTraceRates(args, json);
+  if (args.suite == "rays" || args.suite == "all") failures += runRays(args, json);
   if (args.suite == "grid" || args.suite == "all") failures += runGrid(args, json);
 #endif
   if (!args.json.empty()) {
