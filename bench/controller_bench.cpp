@@ -56,7 +56,13 @@ struct SampledView {
 };
 
 double frameError(const FrameResult& f, const SampledView& v) {
-  return 0.5 * (compareToReference(f.eyes[0].image, v.reference[0]).relMse + compareToReference(f.eyes[1].image, v.reference[1]).relMse);
+  return 0.5 * (relativeMse(f.eyes[0].image, v.reference[0]) + relativeMse(f.eyes[1].image, v.reference[1]));
+}
+
+// The first sampled view: half an interval in (on a frame the fixed walks render), so that no
+// view falls on the controller's start-up probes.
+size_t firstView(const FrameBenchArgs& args) {
+  return size_t(args.errorEvery / 2 / args.fixedStride * args.fixedStride);
 }
 
 // Renders the walk: `choose` gives each frame's options (and sees its measured time after).
@@ -115,9 +121,9 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
   }
   std::printf("\nThe budget controller on walks through scenes: frame time (host wall time of the stereo frame, images "
               "left on the device) mean / p50 / p99 and frames over the budget; error: mean relMSE of both eyes against "
-              "references (%d progressive passes of 1024x1024 photons) of every %dth frame's view; fixed settings render every %dth frame. Fixed settings: each "
-              "setting the controller spent at least 2 %% of a walk in, and uniform ones.\n\n",
-              args.referencePasses, args.errorEvery, args.fixedStride);
+              "references (%d progressive passes of 1024x1024 photons) of every %dth frame's view from frame %zu; fixed settings render every %dth frame. Fixed settings: each "
+              "setting the controller spent at least 3 %% of a walk in, and uniform ones.\n\n",
+              args.referencePasses, args.errorEvery, firstView(args), args.fixedStride);
   for (const std::string& item : splitList(args.walks)) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos) throw Error("--walks: '" + item + "' is not SCENE=TRAJECTORY");
@@ -149,7 +155,7 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
     // The sampled views' references.
     std::vector<SampledView> views;
     const auto referenceStart = Clock::now();
-    for (size_t f = 0; f < trajectory.size(); f += size_t(args.errorEvery)) {
+    for (size_t f = firstView(args); f < trajectory.size(); f += size_t(args.errorEvery)) {
       StereoRig vr = rig;
       vr.head = trajectory[f].head;
       RenderOptions ro = base;
@@ -162,6 +168,9 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
       for (int i = 0; i < args.referencePasses; ++i) reference.addPass();
       views.push_back({int(f), {reference.image(Eye::Left), reference.image(Eye::Right)}});
     }
+    if (views.empty())
+      throw Error("--walks: '" + item + "' has " + std::to_string(trajectory.size()) + " frames, fewer than the first sampled view's " +
+                  std::to_string(firstView(args) + 1) + " (--error-every / 2)");
     std::printf("| %s | references: %zu views in %.0f s |\n", scene.name.c_str(), views.size(), msSince(referenceStart) / 1000.0);
     std::printf("| %s | %zu frames, %dx%d per eye, radius %g, profile %s, %zu reference views |\n", scene.name.c_str(),
                 trajectory.size(), rig.width, rig.height, base.gather.density.radius,

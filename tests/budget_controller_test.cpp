@@ -76,14 +76,18 @@ struct SimRun {
   }
 };
 
-SimRun simulate(BudgetController& c, const std::vector<TraceFrame>& trace) {
+// `plant`: what the frames really cost (default: the model the controller starts with; the
+// controller measures its foveated ratio again and must not move the plant with it).
+SimRun simulate(BudgetController& c, const std::vector<TraceFrame>& trace, const BudgetController* plant = nullptr) {
+  const BudgetController start = c;
+  const BudgetController& truth = plant ? *plant : start;
   SimRun run;
   for (size_t f = 0; f < trace.size(); ++f) {
     const double now = double(f) * kFrameMs;
     const ControlDecision d = c.decide(now);
     if (std::string(d.change) == "raise") ++run.raises, run.raiseTimes.push_back(now);
     if (std::string(d.change) == "lower" || std::string(d.change) == "replan") ++run.lowers;
-    const ControlCosts costs = frameCosts(c, d.setting, trace[f]);
+    const ControlCosts costs = frameCosts(truth, d.setting, trace[f]);
     run.ms.push_back(costs.total());
     run.error.push_back(c.predictError(d.setting));
     c.observe(costs);
@@ -167,10 +171,11 @@ TEST(BudgetController, DoesNotOscillateOnASteadyView) {
   // It settles within the first second; afterwards the noise (+-3%) must not move it.
   int changesLater = 0;
   BudgetController again(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const BudgetController plant = again;
   for (size_t f = 0; f < trace.size(); ++f) {
     const ControlDecision d = again.decide(double(f) * kFrameMs);
     if (f > 180 && std::string(d.change) != "hold") ++changesLater;
-    again.observe(frameCosts(again, d.setting, trace[f]));
+    again.observe(frameCosts(plant, d.setting, trace[f]));
   }
   EXPECT_LE(changesLater, 2);
   EXPECT_LE(run.p99(), kFrameMs);
@@ -456,6 +461,7 @@ TEST(BudgetController, ProfilesRoundTripAndBadOnesAreRefused) {
 // frames keep to the new budget, and each frame is counted against the budget of its decision.
 TEST(BudgetController, FollowsTheDisplaysPeriod) {
   BudgetController c(twoGroups(), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const BudgetController plant = c;
   const std::vector<TraceFrame> trace = walkTrace(900, 900, 900, 1.0, 1, 0.02, 5);
   ControlLog log;
   std::vector<double> ms;
@@ -465,7 +471,7 @@ TEST(BudgetController, FollowsTheDisplaysPeriod) {
     c.setBudget(0.0);  // unknown (a runtime before its first frame): ignored
     const ControlDecision d = c.decide(double(f) * kFrameMs);
     EXPECT_EQ(d.budgetMs, f < 300 ? kFrameMs : (f < 600 ? 1000.0 / 120.0 : 1000.0 / 45.0)) << f;
-    const ControlCosts costs = frameCosts(c, d.setting, trace[f]);
+    const ControlCosts costs = frameCosts(plant, d.setting, trace[f]);
     log.add(d, costs.total(), costs);
     ms.push_back(costs.total());
     c.observe(costs);
@@ -486,11 +492,12 @@ TEST(BudgetController, FollowsTheDisplaysPeriod) {
 
 TEST(BudgetController, LogsEveryFrame) {
   BudgetController c(twoGroups(), paramsFor(5.5), RenderOptions(), &kMask);
+  const BudgetController plant = c;
   const std::vector<TraceFrame> trace = walkTrace(300, 100, 200, 3.0, 20, 0.02, 9);
   ControlLog log;
   for (size_t f = 0; f < trace.size(); ++f) {
     const ControlDecision d = c.decide(double(f) * kFrameMs);
-    const ControlCosts costs = frameCosts(c, d.setting, trace[f]);
+    const ControlCosts costs = frameCosts(plant, d.setting, trace[f]);
     log.add(d, costs.total(), costs);
     c.observe(costs);
   }
@@ -501,6 +508,68 @@ TEST(BudgetController, LogsEveryFrame) {
   EXPECT_GT(j["changes"].get<size_t>(), 0u);
   EXPECT_EQ(j["frames"][0]["change"], "start");
   EXPECT_TRUE(j["frames"][150]["setting"]["levels"].contains("floor"));
+  EXPECT_NEAR(j["foveated_ratio_at_end"].get<double>(), c.foveatedRatio(), 1e-12);
+}
+
+// A profile whose foveated ratio is 4x too low (the H100's Sponza walk, 2026-12-07: a ratio of
+// samples, 2.6 %, where the pass took 10 % of the full-resolution time): the controller that
+// believed it stayed foveated for the whole walk, predicting full resolution at 4x its cost.
+// Here foveation costs much quality (as on Sponza against full-resolution references), so a
+// full-resolution setting with fewer photons is better and fits.
+ControlProfile foveationCostsQuality(double foveatedSamples) {
+  ControlProfile p = twoGroups();
+  p.foveatedError = 0.09;
+  p.foveatedSamples = foveatedSamples;
+  return p;
+}
+
+TEST(BudgetController, MeasuresTheFoveatedPassAtTheStart) {
+  const BudgetController plant(foveationCostsQuality(0.1), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  BudgetController c(foveationCostsQuality(0.025), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const std::vector<TraceFrame> trace = walkTrace(900, 1 << 30, 1 << 30, 1.0, 1, 0.02, 4);
+  std::vector<bool> foveated;
+  SimRun run;
+  for (size_t f = 0; f < trace.size(); ++f) {
+    const ControlDecision d = c.decide(double(f) * kFrameMs);
+    foveated.push_back(d.setting.foveated);
+    const ControlCosts costs = frameCosts(plant, d.setting, trace[f]);
+    run.ms.push_back(costs.total()), run.error.push_back(plant.predictError(d.setting));
+    c.observe(costs);
+  }
+  // The probes: foveated twice (the first frame's allocations), then at full resolution.
+  EXPECT_TRUE(foveated[0] && foveated[1] && !foveated[2]);
+  EXPECT_NEAR(c.foveatedRatio(), 0.1, 0.1 * 0.05);  // the trace's noise is +-2 % a frame
+  EXPECT_FALSE(c.current().foveated);
+  EXPECT_LE(run.p99(), kFrameMs);
+  double bestFixed = 1e30;
+  for (const ControlSetting& s : everySetting(plant.profile(), true)) {
+    const SimRun fixed = simulateFixed(plant, s, trace);
+    if (fixed.p99() <= kFrameMs) bestFixed = std::min(bestFixed, fixed.meanError());
+  }
+  EXPECT_LT(run.meanError(), 1.2 * bestFixed);  // its margin against a fixed setting at the edge, as on the recorded walk
+}
+
+// The ratio changes after the start (another part of the scene): the switch into the foveated
+// pass, when a heavy view forces it, measures it again from the frames either side.
+TEST(BudgetController, MeasuresTheFoveatedPassAgainAtASwitch) {
+  const BudgetController before(foveationCostsQuality(0.1), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const BudgetController after(foveationCostsQuality(0.3), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  BudgetController c(foveationCostsQuality(0.1), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const std::vector<TraceFrame> trace = walkTrace(1200, 600, 1200, 4.0, 1, 0.0, 6);
+  int switches = 0;
+  bool wasFoveated = false;
+  for (size_t f = 0; f < trace.size(); ++f) {
+    const ControlDecision d = c.decide(double(f) * kFrameMs);
+    if (f > 3 && d.setting.foveated != wasFoveated) ++switches;
+    wasFoveated = d.setting.foveated;
+    c.observe(frameCosts(f < 300 ? before : after, d.setting, trace[f]));
+    if (f == 299) {
+      EXPECT_NEAR(c.foveatedRatio(), 0.1, 1e-9);  // full resolution until now: nothing to see
+    }
+  }
+  ASSERT_GT(switches, 0);
+  EXPECT_TRUE(c.current().foveated);
+  EXPECT_NEAR(c.foveatedRatio(), 0.3, 1e-6);
 }
 
 }  // namespace

@@ -111,6 +111,8 @@ expect_error "controller profile '$out/short_profile.json'" render cornell --bac
 expect_error "--profile-out is for --suite effects or controller" bench --suite tables --profile-out "$out/p"
 expect_error "--walks must name SCENE=TRAJECTORY" bench --suite controller --backend cpu
 expect_error "--budgets must be" bench --suite controller --backend cpu --walks "cornell=$out/one.traj" --budgets 5,x
+expect_error "fewer than the first sampled view's 136" bench --suite controller --backend cpu --walks "cornell=$out/one.traj" \
+  --eye-size 8x8 --error-every 270 --fixed-stride 9
 expect_error "--suite must be tables, stereo, foveation, scenes, quality" bench --suite qualty
 expect_error "--reference-passes must be between 2" bench --suite quality --reference-passes 1 --backend cpu
 expect_error "--quality-variants: no variant 'denoised'" bench --suite quality --quality-variants "denoise;denoised" --backend cpu

@@ -11,6 +11,7 @@
 #include "pvr/image/image_io.h"
 #include "pvr/reference/progressive_reference.h"
 #include "pvr/scene/scene.h"
+#include "pvr/util/error.h"
 #include "test_scenes.h"
 
 namespace pvr {
@@ -44,6 +45,24 @@ TEST(ReferenceError, RelativeMseAndMeanRatioOfAScaledImage) {
   ReferenceError e = compareToReference(scaled, reference);
   EXPECT_NEAR(e.relMse, expected, 1e-6 * expected);
   EXPECT_NEAR(e.meanRatio, 1.1, 1e-6);
+  EXPECT_NEAR(relativeMse(scaled, reference), expected, 1e-6 * expected);
+}
+
+// relativeMse alone (the controller bench's per-frame error) over masked-in pixels only: the
+// masked-out half is off by 100x and must not count.
+TEST(ReferenceError, RelativeMseAloneCountsOnlyTheMaskedInPixels) {
+  Image reference(8, 8), test(8, 8);
+  std::vector<uint8_t> mask(64, 0);
+  for (size_t i = 0; i < 64; ++i) {
+    reference.pixels[i] = Vec3(0.2f);
+    mask[i] = i < 32;
+    test.pixels[i] = Vec3(i < 32 ? 0.3f : 20.0f);
+  }
+  const double expected = 0.01 / (0.04 + 0.01);
+  EXPECT_NEAR(relativeMse(test, reference, mask), expected, 1e-6);
+  EXPECT_NEAR(compareToReference(test, reference, mask).relMse, expected, 1e-6);
+  EXPECT_EQ(relativeMse(test, reference, std::vector<uint8_t>(64, 0)), 0.0);
+  EXPECT_THROW(relativeMse(Image(4, 4), reference), Error);
 }
 
 // Two constant images: no variance, so SSIM is its luminance term (2 a b + C1) / (a^2 + b^2 + C1)

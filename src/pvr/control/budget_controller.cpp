@@ -388,11 +388,19 @@ ControlDecision BudgetController::decide(double nowMs) {
     current_.denoise = 0;
     current_.foveated = params_.foveationAvailable;
     d.change = "start";
-  } else if (!settled_ && units_.size() < 2) {
-    d.change = "start";  // the probe again: a renderer's first frame pays for its allocations
+  } else if (!settled_ && units_.size() < (params_.foveationAvailable ? 3u : 2u)) {
+    // The probe again (a renderer's first frame pays for its allocations); then, where a mask
+    // is available, at full resolution, for the foveated pass's time ratio at this view.
+    if (params_.foveationAvailable && units_.size() == 2) current_.foveated = false;
+    d.change = "start";
   } else if (!settled_) {
     settled_ = true;
+    if (params_.foveationAvailable && measured_.size() >= 3 && measured_[1].second.foveated && !measured_[2].second.foveated &&
+        measured_[1].first.rayMs > 0 && measured_[2].first.rayMs > 0)
+      learnFoveatedRatio(measured_[1].first.rayMs / measured_[2].first.rayMs);
     units_.erase(units_.begin());
+    measured_.erase(measured_.begin());
+    while (units_.size() > size_t(params_.window)) units_.erase(units_.begin()), measured_.erase(measured_.begin());
     const double raiseLimit = params_.budgetMs * (1.0 - margin() - params_.raiseHeadroom);
     ControlSetting chosen = current_;
     double chosenError = std::numeric_limits<double>::infinity();
@@ -463,16 +471,18 @@ ControlDecision BudgetController::decide(double nowMs) {
           const double gain = err - predictError(n);
           if (gain > chosenGain && predictMs(n) <= raiseLimit) chosen = n, chosenGain = gain;
         };
+        const bool replan = !replanned_ && overruns_.size() >= 90 && !all_.empty();
         if (all_.empty()) {
           for (const ControlSetting& n : raisesOf(current_)) consider(n);
         } else {
           for (const ControlSetting& n : all_)
-            if (stepsBetween(current_, n, groups_) <= 2) consider(n);
+            if (replan || stepsBetween(current_, n, groups_) <= 2) consider(n);
         }
+        replanned_ |= replan;
         if (!(chosen == current_)) {
+          d.change = replan && stepsBetween(current_, chosen, groups_) > 2 ? "replan" : "raise";
           current_ = chosen;
           lastRaiseMs_ = nowMs;
-          d.change = "raise";
         }
         headroomFrames_ = 0;  // found or not, the next search waits for `holdFrames` more
       }
@@ -492,17 +502,19 @@ double BudgetController::margin() const {
   return std::clamp(worst + 0.02, params_.margin, params_.maxMargin);
 }
 
-void BudgetController::observe(const ControlCosts& measured) {
-  if (lastPredictedMs_ > 0 && settled_) {
-    overruns_.push_back(measured.total() / lastPredictedMs_ - 1.0);
-    if (overruns_.size() > 90) overruns_.erase(overruns_.begin());
-  }
-  const ControlCosts scale = scaleOf(current_);
-  ControlCosts unit = units_.empty() ? ControlCosts{} : units_.back();
-  if (units_.empty()) unit.denoiseMs = profile_.denoiseMsPerIteration;
+void BudgetController::learnFoveatedRatio(double ratio) {
+  if (!(ratio > 0.0) || !finite(ratio)) return;
+  profile_.foveatedSamples = std::clamp(ratio, 0.01, 1.0);
+  // The foveated frames' unit costs were divided by the old ratio.
+  for (size_t i = 0; i < measured_.size(); ++i)
+    if (measured_[i].second.foveated) unitFrom(units_[i], measured_[i].first, measured_[i].second);
+}
+
+void BudgetController::unitFrom(ControlCosts& unit, const ControlCosts& measured, const ControlSetting& s) {
+  const ControlCosts scale = scaleOf(s);
   // A term that did not run this frame (scale 0) keeps what it was last measured at.
-  auto update = [](double& u, double ms, double s) {
-    if (s > 0) u = ms / s;
+  auto update = [](double& u, double ms, double sc) {
+    if (sc > 0) u = ms / sc;
   };
   update(unit.photonMs, measured.photonMs, scale.photonMs);
   update(unit.rayMs, measured.rayMs, scale.rayMs);
@@ -516,8 +528,31 @@ void BudgetController::observe(const ControlCosts& measured) {
   }
   update(unit.denoiseMs, measured.denoiseMs, scale.denoiseMs);
   update(unit.restMs, measured.restMs, scale.restMs);
+}
+
+void BudgetController::observe(const ControlCosts& measured) {
+  if (lastPredictedMs_ > 0 && settled_) {
+    overruns_.push_back(measured.total() / lastPredictedMs_ - 1.0);
+    if (overruns_.size() > 90) overruns_.erase(overruns_.begin());
+  }
+  // A switch between the foveated and the full-resolution pass from one frame to the next
+  // measures their ratio again: the eye rays' time over their scale without the foveated factor.
+  if (settled_ && !measured_.empty() && measured_.back().second.foveated != current_.foveated) {
+    const auto& [lastCosts, lastSetting] = measured_.back();
+    auto raysPerUnit = [&](double ms, ControlSetting s) {
+      s.foveated = false;
+      return ms / scaleOf(s).rayMs;
+    };
+    const double now = raysPerUnit(measured.rayMs, current_), before = raysPerUnit(lastCosts.rayMs, lastSetting);
+    if (now > 0 && before > 0) learnFoveatedRatio(current_.foveated ? now / before : before / now);
+  }
+  ControlCosts unit = units_.empty() ? ControlCosts{} : units_.back();
+  if (units_.empty()) unit.denoiseMs = profile_.denoiseMsPerIteration;
+  unitFrom(unit, measured, current_);
   units_.push_back(unit);
-  if (units_.size() > size_t(params_.window)) units_.erase(units_.begin());
+  measured_.push_back({measured, current_});
+  // While it probes, the probes' frames are all kept (the ratio needs the second and third).
+  if (settled_ && units_.size() > size_t(params_.window)) units_.erase(units_.begin()), measured_.erase(measured_.begin());
 }
 
 nlohmann::json BudgetController::toJson(const ControlSetting& s, const ControlProfile& profile) {
@@ -573,6 +608,7 @@ nlohmann::json ControlLog::toJson(const BudgetController& controller) const {
   return {{"budget_ms", budget},
           {"margin_min", controller.params().margin},
           {"margin_at_end", controller.currentMargin()},
+          {"foveated_ratio_at_end", controller.foveatedRatio()},
           {"profile", controller.profile().scene},
           {"frame_ms", latencyStats(std::move(ms))},
           {"frames_over_budget", framesOverTheirBudget()},

@@ -15,11 +15,18 @@
 // Quality model: each knob's added error (relMSE against the converged reference) measured alone
 // at a calibration view, summed (ControlProfile; `bench --suite effects --profile-out` makes one).
 // It starts by probing the view for two frames at the fewest photons (the first frame's
-// allocations are not counted), then takes the best setting that fits.
+// allocations are not counted), foveated where a mask is available, and a third at full
+// resolution: the two give the foveated eye rays' time over the full-resolution ones' at this
+// view, which replaces the profile's (a profile's ratio from another view, or a sample count, can
+// be 4x off: a controller that believes full resolution costs 4x what it does never leaves the
+// foveated pass). Each later switch between the two measures it again. Then it takes the best
+// setting that fits.
 // Hysteresis: the setting is lowered at once, as far as needed, when the predicted time of the
 // current one passes budget x (1 - margin); it is raised by at most two knob steps at a time (one
 // up, or one up and one down), only after the headroom has held for `holdFrames` frames, at most
-// `maxRaisesPerSecond`, and only for a gain above `minGain`: no oscillation, no popping.
+// `maxRaisesPerSecond`, and only for a gain above `minGain`: no oscillation, no popping. Once,
+// when the first second's overruns replace the start-up margin, the raise searches every setting:
+// the start-up's cautious choice can sit where no two steps lead to the best one that fits.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -159,6 +166,9 @@ class BudgetController {
   const ControlProfile& profile() const { return profile_; }
   const BudgetControllerParams& params() const { return params_; }
   double currentMargin() const { return margin(); }
+  // The foveated eye rays' time over the full-resolution ones', as last measured (the profile's
+  // foveatedSamples until then).
+  double foveatedRatio() const { return profile_.foveatedSamples; }
 
   static nlohmann::json toJson(const ControlSetting& s, const ControlProfile& profile);
 
@@ -174,6 +184,11 @@ class BudgetController {
   ControlSetting best_, current_;
   std::vector<ControlSetting> all_;  ///< every setting, for lowering
   std::vector<ControlCosts> units_;  ///< the last frames' unit costs (ring, newest last)
+  // The same frames' measured costs and settings (units_ is recomputed from them when the
+  // foveated ratio is measured again).
+  std::vector<std::pair<ControlCosts, ControlSetting>> measured_;
+  void unitFrom(ControlCosts& unit, const ControlCosts& measured, const ControlSetting& s);
+  void learnFoveatedRatio(double ratio);
   double margin() const;  ///< the margin now (BudgetControllerParams::margin)
   std::vector<double> overruns_;   ///< the last second's measured / predicted - 1
   double lastPredictedMs_ = 0;
@@ -181,6 +196,7 @@ class BudgetController {
   int headroomFrames_ = 0;
   double lastRaiseMs_ = -1e30;
   bool started_ = false, settled_ = false;
+  bool replanned_ = false;  ///< the one search over every setting when the start-up margin gives way to the measured one
 };
 
 // Every controlled frame: the decision and what the frame then cost. Its JSON (the stats file's

@@ -76,6 +76,21 @@ ImageComparison compareDisplayed(const Image& test, const Image& reference, cons
   return out;
 }
 
+double relativeMse(const Image& test, const Image& reference, const std::vector<uint8_t>& mask, float exposure) {
+  checkComparable(test, reference, mask);
+  double relative = 0;
+  size_t pixels = 0;
+  for (size_t i = 0; i < reference.pixels.size(); ++i) {
+    if (!mask.empty() && !mask[i]) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double x = double(test.pixels[i][c]) * exposure, y = double(reference.pixels[i][c]) * exposure;
+      relative += (x - y) * (x - y) / (y * y + kRelMseRegulariser);
+    }
+    ++pixels;
+  }
+  return pixels ? relative / (3.0 * double(pixels)) : 0.0;
+}
+
 ReferenceError compareToReference(const Image& test, const Image& reference, const std::vector<uint8_t>& mask,
                                   float exposure) {
   checkComparable(test, reference, mask);
@@ -84,21 +99,17 @@ ReferenceError compareToReference(const Image& test, const Image& reference, con
   out.psnr = displayed.psnr;
   out.pixels = displayed.pixels;
   if (out.pixels == 0) return out;
-  double relative = 0, testSum = 0, referenceSum = 0;
+  double testSum = 0, referenceSum = 0;
   const size_t n = reference.pixels.size();
   std::vector<double> a(n), b(n);
   for (size_t i = 0; i < n; ++i) {
     a[i] = displayedLuminance(test.pixels[i], exposure);
     b[i] = displayedLuminance(reference.pixels[i], exposure);
     if (!mask.empty() && !mask[i]) continue;
-    for (int c = 0; c < 3; ++c) {
-      double x = double(test.pixels[i][c]) * exposure, y = double(reference.pixels[i][c]) * exposure;
-      relative += (x - y) * (x - y) / (y * y + kRelMseRegulariser);
-    }
     testSum += luminance(test.pixels[i]);
     referenceSum += luminance(reference.pixels[i]);
   }
-  out.relMse = relative / (3.0 * double(out.pixels));
+  out.relMse = relativeMse(test, reference, mask, exposure);
   out.meanRatio = referenceSum > 0 ? testSum / referenceSum : (testSum == 0 ? 1.0 : std::numeric_limits<double>::infinity());
   // SSIM from local means, variances and covariance (all Gaussian-weighted).
   const int w = reference.width, h = reference.height;

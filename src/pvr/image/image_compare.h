@@ -42,6 +42,11 @@ struct ReferenceError {
   size_t pixels = 0;
 };
 
+// ReferenceError::relMse alone (no SSIM: a fraction of the time, for loops that compare many
+// frames). Masked as compareDisplayed; 0 where no pixel is compared. Throws pvr::Error if the
+// sizes differ.
+double relativeMse(const Image& test, const Image& reference, const std::vector<uint8_t>& mask = {}, float exposure = 1.0f);
+
 // Compares `test` with `reference` (masked as compareDisplayed; SSIM's windows are centred on
 // masked-in pixels). Throws pvr::Error if the sizes differ.
 ReferenceError compareToReference(const Image& test, const Image& reference, const std::vector<uint8_t>& mask = {},
