@@ -694,9 +694,10 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
 
 #ifdef PVR_HAVE_CUDA
 // The photon pass's rays per second beside the ray kernels' (the rays suite), at growing photon
-// counts: a row each, returned for the table after the rays'. At a frame's 512^2 the pass waits on
-// its longest paths (the GPU is not filled), so its rate per ray follows how many rays a scene's
-// paths cast; from 1024^2 it fills the GPU and the rate is that of its traversal and shading.
+// counts, over the binary BVH and the 8-wide one: a row each, returned for the table after the
+// rays'. At a frame's 512^2 the pass waits on its longest paths (the GPU is not filled), so its
+// rate per ray follows how many rays a scene's paths cast; from 1024^2 it fills the GPU and the
+// rate is that of its traversal and shading.
 std::string photonPassRows(const std::string& name, const Scene& scene, CudaFrameBackend& gpu, const CpuBackend& cpu,
                            int repeats, nlohmann::json& json, int& failures) {
   std::string rows;
@@ -706,22 +707,28 @@ std::string photonPassRows(const std::string& name, const Scene& scene, CudaFram
     o.gather.mode = ShadingMode::Full;
     const PhotonTraceParams tp = o.photonTraceParams();
     const PhotonPaths paths = countPhotonPaths(scene.view(), cpu.intersector(), tp);
-    size_t gpuStored = 0;
-    const LatencyStats t = latencyStats(timePhotonTrace(gpu, tp, repeats, gpuStored));
-    const double storedDifference = std::fabs(double(gpuStored) - double(paths.stored));
-    const bool ok = storedDifference <= 1e-3 * double(tp.photonCount);
-    failures += ok ? 0 : 1;
     auto mrays = [&](double ms) { return ms > 0 ? double(paths.rays) / (ms * 1e3) : 0.0; };
-    char row[512];
-    std::snprintf(row, sizeof row, "| %s | %ux%u | %.2f M (%.2f) | %zu / %llu | %.3f / %.3f | %.0f / %.0f | %s |\n",
-                  name.c_str(), side, side, paths.rays * 1e-6, double(paths.rays) / double(tp.photonCount), gpuStored,
-                  (unsigned long long)paths.stored, t.p50, t.p99, mrays(t.p50), mrays(t.p99), ok ? "ok" : "MISMATCH");
-    rows += row;
-    json.push_back({{"suite", "rays"}, {"stage", "photon pass"}, {"scene", name}, {"photons", tp.photonCount},
-                    {"max_depth", tp.maxDepth}, {"rays", paths.rays}, {"stored_gpu", gpuStored},
-                    {"stored_cpu", paths.stored}, {"repeats", repeats}, {"pass", t}, {"mrays_s", mrays(t.p50)},
-                    {"p99_mrays_s", mrays(t.p99)}, {"check", ok ? "ok" : "MISMATCH"}});
+    for (PhotonPassBvh bvh : {PhotonPassBvh::Binary, PhotonPassBvh::Wide}) {
+      gpu.setPhotonPassBvh(bvh);
+      const char* bvhName = bvh == PhotonPassBvh::Wide ? "8-wide" : "binary";
+      size_t gpuStored = 0;
+      const LatencyStats t = latencyStats(timePhotonTrace(gpu, tp, repeats, gpuStored));
+      const double storedDifference = std::fabs(double(gpuStored) - double(paths.stored));
+      const bool ok = storedDifference <= 1e-3 * double(tp.photonCount);
+      failures += ok ? 0 : 1;
+      char row[512];
+      std::snprintf(row, sizeof row, "| %s | %s | %ux%u | %.2f M (%.2f) | %zu / %llu | %.3f / %.3f | %.0f / %.0f | %s |\n",
+                    name.c_str(), bvhName, side, side, paths.rays * 1e-6, double(paths.rays) / double(tp.photonCount),
+                    gpuStored, (unsigned long long)paths.stored, t.p50, t.p99, mrays(t.p50), mrays(t.p99),
+                    ok ? "ok" : "MISMATCH");
+      rows += row;
+      json.push_back({{"suite", "rays"}, {"stage", "photon pass"}, {"scene", name}, {"bvh", bvhName},
+                      {"photons", tp.photonCount}, {"max_depth", tp.maxDepth}, {"rays", paths.rays},
+                      {"stored_gpu", gpuStored}, {"stored_cpu", paths.stored}, {"repeats", repeats}, {"pass", t},
+                      {"mrays_s", mrays(t.p50)}, {"p99_mrays_s", mrays(t.p99)}, {"check", ok ? "ok" : "MISMATCH"}});
+    }
   }
+  gpu.setPhotonPassBvh(PhotonPassBvh::Binary);
   return rows;
 }
 
@@ -802,13 +809,14 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
     }
     photonRows += photonPassRows(name, scene, gpu, cpu, repeats, json, failures);
   }
-  std::printf("\nPhoton pass (trace, scan of the counts, compaction: a frame's trace stage), full shading's photons "
+  std::printf("\nPhoton pass (trace, scan of the counts, compaction: a frame's trace stage) over the binary BVH (the "
+              "frames') and the 8-wide one, full shading's photons "
               "(no direct photons stored), up to 8 interactions a path; %d runs each (CUDA events; after a warm-up "
               "run). Rays: the paths' segments, counted on the CPU by the same code; stored photons GPU against CPU "
               "(the same paths but for rounding, which may tip a few: they differ by at most 0.1 %% of the emitted "
               "photons)\n\n"
-              "| scene | photons | rays (per photon) | stored GPU / CPU | pass ms (median / p99) | Mrays/s (median / p99) | "
-              "check |\n|---|---|---|---|---|---|---|\n%s",
+              "| scene | BVH | photons | rays (per photon) | stored GPU / CPU | pass ms (median / p99) | Mrays/s (median / p99) | "
+              "check |\n|---|---|---|---|---|---|---|---|\n%s",
               repeats, photonRows.c_str());
   return failures;
 }

@@ -25,5 +25,10 @@ for phase in "$@"; do
   walkfit_sibenik)  # the fit and the walks (the per-frame error is relMSE alone since the third call: the SSIM took most of the second call)
     controller scenes/sibenik.json .scenes/sibenik.traj walkfit_sibenik \
       --profiles docs/results/h200-2026-12-03/profile --profile-out $results/walkfit --fixed-stride 9 ;;
+  rays)  # the ray kernels, and the photon pass over the binary and the 8-wide BVH at 256^2..2048^2 photons
+    step rays 200 stdbuf -oL .gpu/run.sh .gpu/bin/photonvr bench --suite rays \
+      --rays-scenes cornell-dense,scenes/dabrovic-sponza.json,scenes/sibenik.json --json $results/rays.json ;;
+  photon_tests)  # the stored photons against the CPU's over both BVHs
+    step photon_tests 60 .gpu/run.sh .gpu/bin/pvr_gpu_tests --gtest_filter=*StoredPhotonsMatchTheCpu* ;;
   esac
 done

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "pvr/accel/wide_bvh.h"
 #include "pvr/cuda/cuda_stage_clock.h"
 #include "pvr/cuda/denoise.cuh"
 #include "pvr/cuda/display_handover.h"
@@ -41,6 +42,16 @@ struct CudaFrameBackend::Impl {
   cudaDeviceProp properties{};
   cuda::DeviceScene deviceScene;
   cuda::GpuPhotonTracer tracer;
+  // The photon pass's 8-wide BVH (setPhotonPassBvh), built at first use.
+  struct WidePhotonBvh {
+    cuda::DeviceBuffer<WideBvhNode> nodes;
+    cuda::DeviceBuffer<BvhTriangle> triangles;
+    WideBvhIntersector intersector;
+    bool inUse = false;
+  } wide;
+  uint32_t tracePhotons(const PhotonTraceParams& params) {
+    return wide.inUse ? tracer.trace(deviceScene, wide.intersector, params, stream) : tracer.trace(deviceScene, params, stream);
+  }
   cuda::RollingPhotons rolling;
   bool rollingInUse = false;  ///< the map is built over the rolling slices, not the last trace
   const Photon* mapPhotons() const { return rollingInUse ? rolling.photons() : tracer.photons(); }
@@ -159,7 +170,7 @@ CUstream_st* CudaFrameBackend::stream() const { return impl_->stream; }
 size_t CudaFrameBackend::tracePhotons(const PhotonTraceParams& params, int slot, int slots) {
   Impl& m = *impl_;
   m.frame = Impl::FrameState();
-  const uint32_t traced = m.tracer.trace(m.deviceScene, params, m.stream);
+  const uint32_t traced = m.tracePhotons(params);
   m.rollingInUse = slots > 1;
   if (!m.rollingInUse) return traced;
   m.rolling.store(slot, slots, m.tracer.photons(), traced, m.tracer.bounds(), m.stream);
@@ -381,9 +392,24 @@ GatherPoint CudaFrameBackend::gatherPointToHost(size_t pixel) {
 const float* CudaFrameBackend::deviceInverseDepth(Eye eye) const { return impl_->eyePass.inverseDepth(eye); }
 void* CudaFrameBackend::deviceStream() const { return impl_->stream; }
 
+void CudaFrameBackend::setPhotonPassBvh(PhotonPassBvh bvh) {
+  Impl& m = *impl_;
+  if (bvh == PhotonPassBvh::Wide && m.wide.triangles.capacity() == 0 && m.scene.triangleCount() > 0) {
+    const WideBvh built = WideBvh::build(m.scene);
+    // On the frame's stream: ordered before its photon pass (a non-blocking stream does not wait
+    // for the default one).
+    m.wide.nodes.upload(built.nodes().data(), built.nodes().size(), "wide BVH nodes", m.stream);
+    m.wide.triangles.upload(built.triangles().data(), built.triangles().size(), "wide BVH triangles", m.stream);
+    m.wide.intersector.bvh = {m.wide.nodes.data(), m.wide.triangles.data(), uint32_t(built.nodes().size()),
+                              uint32_t(built.triangles().size())};
+    m.wide.intersector.alphaScene = m.deviceScene.intersector.alphaScene;
+  }
+  m.wide.inUse = bvh == PhotonPassBvh::Wide;
+}
+
 std::vector<Photon> CudaFrameBackend::tracePhotonsToHost(const PhotonTraceParams& params) {
   Impl& m = *impl_;
-  uint32_t n = m.tracer.trace(m.deviceScene, params, m.stream);
+  uint32_t n = m.tracePhotons(params);
   std::vector<Photon> photons(n);
   if (n)
     PVR_CUDA_CHECK(cudaMemcpyAsync(photons.data(), m.tracer.photons(), n * sizeof(Photon), cudaMemcpyDeviceToHost, m.stream));

@@ -14,11 +14,12 @@ constexpr int kPhotonBlock = 128;
 // its idle lanes with one atomic) and starts it at once, so that the warp's lanes keep tracing
 // instead of idling until its longest path ends (Aila and Laine 2009). A photon's random numbers
 // and output slots follow its index, so the result does not depend on which lane traced it.
-__global__ void __launch_bounds__(kPhotonBlock) tracePhotonsKernel(SceneView scene, SceneIntersector sceneIntersector,
+template <class Intersector>
+__global__ void __launch_bounds__(kPhotonBlock) tracePhotonsKernel(SceneView scene, Intersector sceneIntersector,
                                                                    PhotonTraceParams params, uint32_t first, uint32_t n,
                                                                    Photon* slots, uint32_t* counts, uint32_t* bounds,
                                                                    uint32_t* nextPhoton) {
-  const SceneIntersector intersector = withSharedStack<kPhotonBlock>(sceneIntersector);
+  const Intersector intersector = withSharedStack<kPhotonBlock>(sceneIntersector);
   const unsigned lane = threadIdx.x & 31u;
   Bounds3 b;
   PhotonPath path;
@@ -79,6 +80,17 @@ size_t GpuPhotonTracer::memoryBytes() const {
 }
 
 uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParams& params, cudaStream_t stream) {
+  return traceWith(scene.view, scene.intersector, params, stream);
+}
+
+uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const WideBvhIntersector& wide, const PhotonTraceParams& params,
+                                cudaStream_t stream) {
+  return traceWith(scene.view, wide, params, stream);
+}
+
+template <class Intersector>
+uint32_t GpuPhotonTracer::traceWith(const SceneView& scene, const Intersector& intersector, const PhotonTraceParams& params,
+                                    cudaStream_t stream) {
   const int slotsPerPhoton = std::max(params.maxDepth, 1);
   // Chunks bound the scratch slots to 256 MiB whatever the photon count and depth.
   const uint32_t last = params.lastPhoton();
@@ -96,7 +108,8 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
   // As many blocks as stay resident: the lanes take photons until none are left.
   static const unsigned residentBlocks = [] {
     int perMultiprocessor = 0;
-    PVR_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perMultiprocessor, tracePhotonsKernel, kPhotonBlock, 0));
+    PVR_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perMultiprocessor, tracePhotonsKernel<Intersector>,
+                                                                 kPhotonBlock, 0));
     return unsigned(std::max(perMultiprocessor, 1) * multiprocessorCount());
   }();
   uint32_t init[6];
@@ -107,9 +120,9 @@ uint32_t GpuPhotonTracer::trace(const DeviceScene& scene, const PhotonTraceParam
     uint32_t n = std::min(chunk, last - first);
     PVR_CUDA_CHECK(cudaMemsetAsync(counts_.data() + n, 0, sizeof(uint32_t), stream));
     PVR_CUDA_CHECK(cudaMemsetAsync(summary_.data() + 6, 0, sizeof(uint32_t), stream));  // the next photon to start
-    launch("photon trace", tracePhotonsKernel, std::min(blocksFor(n, kPhotonBlock), residentBlocks), kPhotonBlock, 0, stream,
-           scene.view, scene.intersector, params, first, n, slots_.data(), counts_.data(), summary_.data(),
-           summary_.data() + 6);
+    launch("photon trace", tracePhotonsKernel<Intersector>, std::min(blocksFor(n, kPhotonBlock), residentBlocks),
+           kPhotonBlock, 0, stream, scene, intersector, params, first, n, slots_.data(), counts_.data(),
+           summary_.data(), summary_.data() + 6);
     size_t bytes = temp_.capacity();
     PVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, counts_.data(), offsets_.data(), n + 1, stream));
     PVR_CUDA_CHECK(cudaMemcpyAsync(hostSummary_, summary_.data(), 6 * sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));

@@ -3,6 +3,7 @@
 // compacted in photon-index order (the CPU backend's order, so the two compare element by element).
 #include <vector>
 
+#include "pvr/accel/wide_bvh_traversal.h"
 #include "pvr/cuda/device_scene.cuh"
 
 namespace pvr::cuda {
@@ -15,12 +16,19 @@ class GpuPhotonTracer {
   // Traces params.photonCount photons; returns how many were stored. Synchronizes the stream
   // once per chunk of photons (to learn the count and the photons' bounds).
   uint32_t trace(const DeviceScene& scene, const PhotonTraceParams& params, cudaStream_t stream);
+  // The same over the 8-wide BVH (`wide`, the scene's triangles in its own order): the same
+  // photons, the closest hits being the same triangles.
+  uint32_t trace(const DeviceScene& scene, const WideBvhIntersector& wide, const PhotonTraceParams& params,
+                 cudaStream_t stream);
   const Photon* photons() const { return photons_.data(); }
   uint32_t count() const { return count_; }
   const Bounds3& bounds() const { return bounds_; }
   size_t memoryBytes() const;
 
  private:
+  template <class Intersector>
+  uint32_t traceWith(const SceneView& scene, const Intersector& intersector, const PhotonTraceParams& params,
+                     cudaStream_t stream);
   DeviceBuffer<Photon> slots_, photons_;
   DeviceBuffer<uint32_t> counts_, offsets_;
   DeviceBuffer<uint32_t> summary_;  ///< the bounds (6, as orderedBits) and the next photon to start
