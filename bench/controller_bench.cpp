@@ -35,7 +35,8 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 // One walk at one policy (the controller, or a fixed setting).
 struct Walk {
   std::string name;
-  std::vector<double> ms;                   ///< per frame
+  std::vector<double> ms;                   ///< per frame rendered
+  std::vector<int> frames;                  ///< the walk's frame of each
   std::vector<std::pair<int, double>> error;  ///< (frame, mean relMSE of the eyes) at sampled frames
   ControlLog log;                           ///< the controller's
   std::map<std::string, int> settingFrames;  ///< the controller's time in each setting
@@ -65,8 +66,14 @@ size_t firstView(const FrameBenchArgs& args) {
   return size_t(args.errorEvery / 2 / args.fixedStride * args.fixedStride);
 }
 
+// Frames a strided walk renders one by one before each sampled view (a third of a second at
+// 90 Hz): the view's frame then has the history of the denoiser and of TAA that a walk at every
+// frame gives it, where every 9th frame alone would have reprojected across 9 frames of motion
+// and shown a fixed setting's denoiser with a history it rejected.
+constexpr size_t kHistoryFrames = 30;
+
 // Renders the walk: `choose` gives each frame's options (and sees its measured time after).
-// `stride` > 1: every stride-th frame only (the sampled views' frames are among them).
+// `stride` > 1: every stride-th frame, and the kHistoryFrames frames before each sampled view.
 template <class Choose, class Observe>
 Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFrame>& trajectory,
           const std::vector<SampledView>& views, Choose choose, Observe observe, int stride = 1) {
@@ -74,7 +81,9 @@ Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFr
   renderer.resetHistory();
   size_t nextView = 0;
   const auto start = Clock::now();
-  for (size_t f = 0; f < trajectory.size(); f += size_t(stride)) {
+  for (size_t f = 0; f < trajectory.size(); ++f) {
+    const bool beforeView = nextView < views.size() && f + kHistoryFrames >= size_t(views[nextView].frame);
+    if (f % size_t(stride) != 0 && !beforeView) continue;
     rig.head = trajectory[f].head;
     RenderOptions o = choose(msSince(start));
     copyGaze(trajectory[f], o.foveation);
@@ -82,6 +91,7 @@ Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFr
     FrameResult frame = renderer.render(rig, o, false);
     const double ms = msSince(frameStart);
     w.ms.push_back(ms);
+    w.frames.push_back(int(f));
     observe(frame.timings, ms);
     if (nextView < views.size() && views[nextView].frame == int(f)) {
       // The shown image of this frame, read back outside the timed frame (a second render of the
@@ -121,9 +131,10 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
   }
   std::printf("\nThe budget controller on walks through scenes: frame time (host wall time of the stereo frame, images "
               "left on the device) mean / p50 / p99 and frames over the budget; error: mean relMSE of both eyes against "
-              "references (%d progressive passes of 1024x1024 photons) of every %dth frame's view from frame %zu; fixed settings render every %dth frame. Fixed settings: each "
+              "references (%d progressive passes of 1024x1024 photons) of every %dth frame's view from frame %zu; fixed settings render every %dth frame and "
+              "the %zu before each of those views (their temporal history). Fixed settings: each "
               "setting the controller spent at least 3 %% of a walk in, and uniform ones.\n\n",
-              args.referencePasses, args.errorEvery, firstView(args), args.fixedStride);
+              args.referencePasses, args.errorEvery, firstView(args), args.fixedStride, kHistoryFrames);
   for (const std::string& item : splitList(args.walks)) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos) throw Error("--walks: '" + item + "' is not SCENE=TRAJECTORY");
@@ -315,7 +326,7 @@ int runControllerBench(const FrameBenchArgs& args, BackendKind kind, nlohmann::j
       json.push_back({{"suite", "controller"}, {"scene", scene.name}, {"policy", "fixed"}, {"setting", nlohmann::json::parse(name)},
                       {"defaults", name == defaultsName},
                       {"frame", latencyStats(w.ms)}, {"mean_rel_mse", w.meanError()}, {"frame_ms", frames},
-                      {"frame_stride", args.fixedStride}, {"errors", errors}});
+                      {"frame_stride", args.fixedStride}, {"frame_index", w.frames}, {"errors", errors}});
     }
   }
   return failures;

@@ -74,7 +74,8 @@ def main():
                 best = fixed.get(json.dumps(json.loads(summary["best_fixed"]), sort_keys=True))
                 if best:
                     stride = best.get("frame_stride", 1)
-                    ta.plot([k * stride for k in range(len(best["frame_ms"]))], best["frame_ms"], color=c, lw=0.7, alpha=0.35, label=f"best fixed meeting {budget:g} ms")
+                    index = best.get("frame_index", [k * stride for k in range(len(best["frame_ms"]))])
+                    ta.plot(index, best["frame_ms"], color=c, lw=0.7, alpha=0.35, label=f"best fixed meeting {budget:g} ms")
                     ea.plot([e[0] for e in best["errors"]], [e[1] for e in best["errors"]], "x:", color=c, ms=4,
                             lw=1, alpha=0.6, label=f"best fixed, {budget:g} ms")
         ta.set_title(f"{scene}: frame time")
