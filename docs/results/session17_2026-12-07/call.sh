@@ -22,6 +22,9 @@ for phase in "$@"; do
   controller_sponza)  # the controller and the fixed settings with the second call's fitted profile
     controller scenes/dabrovic-sponza.json .scenes/sponza.traj controller_sponza \
       --profiles $here/walkfit --fixed-stride 9 ;;
+  walkfit_sponza_again)  # the fit and the walks anew on Sponza, with the views and histories of e969a30
+    controller scenes/dabrovic-sponza.json .scenes/sponza.traj walkfit_sponza_again \
+      --profiles docs/results/h200-2026-12-03/profile --profile-out $results/walkfit --fixed-stride 9 ;;
   walkfit_sibenik)  # the fit and the walks (the per-frame error is relMSE alone since the third call: the SSIM took most of the second call)
     controller scenes/sibenik.json .scenes/sibenik.traj walkfit_sibenik \
       --profiles docs/results/h200-2026-12-03/profile --profile-out $results/walkfit --fixed-stride 9 ;;
