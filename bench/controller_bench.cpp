@@ -35,7 +35,7 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 // One walk at one policy (the controller, or a fixed setting).
 struct Walk {
   std::string name;
-  std::vector<double> ms;                   ///< per frame rendered
+  std::vector<double> ms;                   ///< per frame of the stride
   std::vector<int> frames;                  ///< the walk's frame of each
   std::vector<std::pair<int, double>> error;  ///< (frame, mean relMSE of the eyes) at sampled frames
   ControlLog log;                           ///< the controller's
@@ -90,8 +90,9 @@ Walk walk(FrameRenderer& renderer, StereoRig rig, const std::vector<TrajectoryFr
     const auto frameStart = Clock::now();
     FrameResult frame = renderer.render(rig, o, false);
     const double ms = msSince(frameStart);
-    w.ms.push_back(ms);
-    w.frames.push_back(int(f));
+    // Frame times of the stride's frames only (the windows before the views would weigh the
+    // statistics towards a ninth of the walk); the views' frames are among them.
+    if (f % size_t(stride) == 0) w.ms.push_back(ms), w.frames.push_back(int(f));
     observe(frame.timings, ms);
     if (nextView < views.size() && views[nextView].frame == int(f)) {
       // The shown image of this frame, read back outside the timed frame (a second render of the

@@ -508,7 +508,8 @@ TEST(BudgetController, LogsEveryFrame) {
   EXPECT_GT(j["changes"].get<size_t>(), 0u);
   EXPECT_EQ(j["frames"][0]["change"], "start");
   EXPECT_TRUE(j["frames"][150]["setting"]["levels"].contains("floor"));
-  EXPECT_NEAR(j["foveated_ratio_at_end"].get<double>(), c.foveatedRatio(), 1e-12);
+  // The generic profile's ratio is the plant's (0.25): measured at the start within the noise.
+  EXPECT_NEAR(j["foveated_ratio_at_end"].get<double>(), 0.25, 0.25 * 0.05);
 }
 
 // A profile whose foveated ratio is 4x too low (the H100's Sponza walk, 2026-12-07: a ratio of
@@ -550,12 +551,14 @@ TEST(BudgetController, MeasuresTheFoveatedPassAtTheStart) {
 }
 
 // The ratio changes after the start (another part of the scene): the switch into the foveated
-// pass, when a heavy view forces it, measures it again from the frames either side.
+// pass, when a heavy view forces it, measures it again from the frames either side, within the
+// noise and the view's change from one frame to the next (a 1 s turn). The profile's ratio is 4x
+// off, and the start-up probe corrects it first.
 TEST(BudgetController, MeasuresTheFoveatedPassAgainAtASwitch) {
   const BudgetController before(foveationCostsQuality(0.1), paramsFor(kFrameMs), RenderOptions(), &kMask);
-  const BudgetController after(foveationCostsQuality(0.3), paramsFor(kFrameMs), RenderOptions(), &kMask);
-  BudgetController c(foveationCostsQuality(0.1), paramsFor(kFrameMs), RenderOptions(), &kMask);
-  const std::vector<TraceFrame> trace = walkTrace(1200, 600, 1200, 4.0, 1, 0.0, 6);
+  const BudgetController after(foveationCostsQuality(0.18), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  BudgetController c(foveationCostsQuality(0.025), paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const std::vector<TraceFrame> trace = walkTrace(1200, 600, 1200, 4.0, 90, 0.02, 6);
   int switches = 0;
   bool wasFoveated = false;
   for (size_t f = 0; f < trace.size(); ++f) {
@@ -564,12 +567,13 @@ TEST(BudgetController, MeasuresTheFoveatedPassAgainAtASwitch) {
     wasFoveated = d.setting.foveated;
     c.observe(frameCosts(f < 300 ? before : after, d.setting, trace[f]));
     if (f == 299) {
-      EXPECT_NEAR(c.foveatedRatio(), 0.1, 1e-9);  // full resolution until now: nothing to see
+      EXPECT_EQ(switches, 0);
+      EXPECT_NEAR(c.foveatedRatio(), 0.1, 0.1 * 0.05);  // the probe's, within the noise
     }
   }
   ASSERT_GT(switches, 0);
   EXPECT_TRUE(c.current().foveated);
-  EXPECT_NEAR(c.foveatedRatio(), 0.3, 1e-6);
+  EXPECT_NEAR(c.foveatedRatio(), 0.18, 0.18 * 0.1);
 }
 
 }  // namespace

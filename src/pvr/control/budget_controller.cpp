@@ -480,9 +480,9 @@ ControlDecision BudgetController::decide(double nowMs) {
         }
         replanned_ |= replan;
         if (!(chosen == current_)) {
-          d.change = replan && stepsBetween(current_, chosen, groups_) > 2 ? "replan" : "raise";
           current_ = chosen;
           lastRaiseMs_ = nowMs;
+          d.change = "raise";
         }
         headroomFrames_ = 0;  // found or not, the next search waits for `holdFrames` more
       }
@@ -505,9 +505,12 @@ double BudgetController::margin() const {
 void BudgetController::learnFoveatedRatio(double ratio) {
   if (!(ratio > 0.0) || !finite(ratio)) return;
   profile_.foveatedSamples = std::clamp(ratio, 0.01, 1.0);
-  // The foveated frames' unit costs were divided by the old ratio.
+  // The foveated frames' unit costs were divided by the old ratio. (The density-per-ray ratio
+  // stays the newest frame's, not the last foveated one's.)
+  const double densityPerRay = densityPerRay_;
   for (size_t i = 0; i < measured_.size(); ++i)
     if (measured_[i].second.foveated) unitFrom(units_[i], measured_[i].first, measured_[i].second);
+  densityPerRay_ = densityPerRay;
 }
 
 void BudgetController::unitFrom(ControlCosts& unit, const ControlCosts& measured, const ControlSetting& s) {
@@ -531,20 +534,30 @@ void BudgetController::unitFrom(ControlCosts& unit, const ControlCosts& measured
 }
 
 void BudgetController::observe(const ControlCosts& measured) {
-  if (lastPredictedMs_ > 0 && settled_) {
-    overruns_.push_back(measured.total() / lastPredictedMs_ - 1.0);
-    if (overruns_.size() > 90) overruns_.erase(overruns_.begin());
-  }
   // A switch between the foveated and the full-resolution pass from one frame to the next
-  // measures their ratio again: the eye rays' time over their scale without the foveated factor.
+  // measures their ratio again: the eye rays' time over their scale without the foveated factor
+  // (the groups' levels may change with it). Two frames may also differ in view and noise, and the
+  // level costs are modelled: the ratio moves at most 2x per switch, so one odd pair cannot set it
+  // to where the controller would never switch again.
+  bool remeasured = false;
   if (settled_ && !measured_.empty() && measured_.back().second.foveated != current_.foveated) {
-    const auto& [lastCosts, lastSetting] = measured_.back();
     auto raysPerUnit = [&](double ms, ControlSetting s) {
       s.foveated = false;
       return ms / scaleOf(s).rayMs;
     };
-    const double now = raysPerUnit(measured.rayMs, current_), before = raysPerUnit(lastCosts.rayMs, lastSetting);
-    if (now > 0 && before > 0) learnFoveatedRatio(current_.foveated ? now / before : before / now);
+    const double now = raysPerUnit(measured.rayMs, current_),
+                 before = raysPerUnit(measured_.back().first.rayMs, measured_.back().second);
+    if (now > 0 && before > 0) {
+      const double old = profile_.foveatedSamples;
+      learnFoveatedRatio(std::clamp(current_.foveated ? now / before : before / now, 0.5 * old, 2.0 * old));
+      remeasured = true;
+    }
+  }
+  // The frame's overrun against its prediction, unless that prediction used the ratio just
+  // corrected (it would hold the margin high for a second after the model is right).
+  if (lastPredictedMs_ > 0 && settled_ && !remeasured) {
+    overruns_.push_back(measured.total() / lastPredictedMs_ - 1.0);
+    if (overruns_.size() > 90) overruns_.erase(overruns_.begin());
   }
   ControlCosts unit = units_.empty() ? ControlCosts{} : units_.back();
   if (units_.empty()) unit.denoiseMs = profile_.denoiseMsPerIteration;

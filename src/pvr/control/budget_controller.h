@@ -19,8 +19,8 @@
 // resolution: the two give the foveated eye rays' time over the full-resolution ones' at this
 // view, which replaces the profile's (a profile's ratio from another view, or a sample count, can
 // be 4x off: a controller that believes full resolution costs 4x what it does never leaves the
-// foveated pass). Each later switch between the two measures it again. Then it takes the best
-// setting that fits.
+// foveated pass; the third frame may run over the budget). Each later switch between the two
+// measures it again. Then it takes the best setting that fits.
 // Hysteresis: the setting is lowered at once, as far as needed, when the predicted time of the
 // current one passes budget x (1 - margin); it is raised by at most two knob steps at a time (one
 // up, or one up and one down), only after the headroom has held for `holdFrames` frames, at most

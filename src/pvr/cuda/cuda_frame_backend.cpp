@@ -400,6 +400,7 @@ void CudaFrameBackend::setPhotonPassBvh(PhotonPassBvh bvh) {
     // for the default one).
     m.wide.nodes.upload(built.nodes().data(), built.nodes().size(), "wide BVH nodes", m.stream);
     m.wide.triangles.upload(built.triangles().data(), built.triangles().size(), "wide BVH triangles", m.stream);
+    PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));  // before `built`'s host arrays go out of scope
     m.wide.intersector.bvh = {m.wide.nodes.data(), m.wide.triangles.data(), uint32_t(built.nodes().size()),
                               uint32_t(built.triangles().size())};
     m.wide.intersector.alphaScene = m.deviceScene.intersector.alphaScene;
