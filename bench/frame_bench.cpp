@@ -698,8 +698,8 @@ int runFoveation(const FrameBenchArgs& args, const Scene& scene, FrameRenderer& 
 // rays'. At a frame's 512^2 the pass waits on its longest paths (the GPU is not filled), so its
 // rate per ray follows how many rays a scene's paths cast; from 1024^2 it fills the GPU and the
 // rate is that of its traversal and shading.
-std::string photonPassRows(const std::string& name, const Scene& scene, CudaFrameBackend& gpu, const CpuBackend& cpu,
-                           int repeats, nlohmann::json& json, int& failures) {
+std::string photonPassRows(const std::string& name, const Scene& scene, const WideBvh& wide, CudaFrameBackend& gpu,
+                           const CpuBackend& cpu, int repeats, nlohmann::json& json, int& failures) {
   std::string rows;
   for (uint32_t side : {256u, 512u, 1024u, 2048u}) {
     RenderOptions o;
@@ -709,7 +709,7 @@ std::string photonPassRows(const std::string& name, const Scene& scene, CudaFram
     const PhotonPaths paths = countPhotonPaths(scene.view(), cpu.intersector(), tp);
     auto mrays = [&](double ms) { return ms > 0 ? double(paths.rays) / (ms * 1e3) : 0.0; };
     for (PhotonPassBvh bvh : {PhotonPassBvh::Binary, PhotonPassBvh::Wide}) {
-      gpu.setPhotonPassBvh(bvh);
+      gpu.setPhotonPassBvh(bvh, &wide);
       const char* bvhName = bvh == PhotonPassBvh::Wide ? "8-wide" : "binary";
       size_t gpuStored = 0;
       const LatencyStats t = latencyStats(timePhotonTrace(gpu, tp, repeats, gpuStored));
@@ -807,7 +807,7 @@ int runRays(const FrameBenchArgs& args, nlohmann::json& json) {
                       {"shadow", shadow}, {"diffuse", diffuse}, {"check_agreement", agreement}});
       std::fflush(stdout);
     }
-    photonRows += photonPassRows(name, scene, gpu, cpu, repeats, json, failures);
+    photonRows += photonPassRows(name, scene, wide, gpu, cpu, repeats, json, failures);
   }
   std::printf("\nPhoton pass (trace, scan of the counts, compaction: a frame's trace stage) over the binary BVH (the "
               "frames') and the 8-wide one, full shading's photons "

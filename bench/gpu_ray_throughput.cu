@@ -3,6 +3,7 @@
 
 #include "gpu_ray_throughput.h"
 #include "pvr/cuda/device_scene.cuh"
+#include "pvr/cuda/device_wide_bvh.h"
 #include "pvr/cuda/eye_kernels.cuh"
 
 namespace pvr {
@@ -139,11 +140,9 @@ GpuRayThroughput measureRays(CudaFrameBackend& backend, const Intersector& scene
 struct GpuRayBench::Impl {
   CudaFrameBackend& backend;
   DeviceBuffer<BvhNode> binaryNodes;
-  DeviceBuffer<WideBvhNode> wideNodes;
   DeviceBuffer<BvhTriangle> triangles;
   BvhIntersector binary;
-  WideBvhIntersector wide;
-  bool isWide = false;
+  DeviceWideBvh wide;
   explicit Impl(CudaFrameBackend& b) : backend(b) {}
 };
 
@@ -156,12 +155,7 @@ GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const Bvh& bvh) : impl_(std:
 }
 
 GpuRayBench::GpuRayBench(CudaFrameBackend& backend, const WideBvh& bvh) : impl_(std::make_unique<Impl>(backend)) {
-  impl_->isWide = true;
-  if (!bvh.nodes().empty()) impl_->wideNodes.upload(bvh.nodes().data(), bvh.nodes().size(), "wide BVH nodes");
-  impl_->triangles.upload(bvh.triangles().data(), bvh.triangles().size(), "BVH triangles");
-  impl_->wide.bvh = {impl_->wideNodes.data(), impl_->triangles.data(), uint32_t(bvh.nodes().size()),
-                     uint32_t(bvh.triangles().size())};
-  impl_->wide.alphaScene = backend.deviceScene().intersector.alphaScene;
+  impl_->wide.upload(bvh, backend.deviceScene().intersector.alphaScene, nullptr);
 }
 
 GpuRayBench::~GpuRayBench() = default;
@@ -169,9 +163,9 @@ GpuRayBench::~GpuRayBench() = default;
 GpuRayThroughput GpuRayBench::measure(const StereoRig& rig, int repeats, bool sharedStack) {
   PVR_CUDA_CHECK(cudaDeviceSynchronize());
   Impl& m = *impl_;
-  if (m.isWide)
-    return sharedStack ? measureRays<WideBvhIntersector, true>(m.backend, m.wide, rig, repeats)
-                       : measureRays<WideBvhIntersector, false>(m.backend, m.wide, rig, repeats);
+  if (m.wide.uploaded)
+    return sharedStack ? measureRays<WideBvhIntersector, true>(m.backend, m.wide.intersector, rig, repeats)
+                       : measureRays<WideBvhIntersector, false>(m.backend, m.wide.intersector, rig, repeats);
   return sharedStack ? measureRays<BvhIntersector, true>(m.backend, m.binary, rig, repeats)
                      : measureRays<BvhIntersector, false>(m.backend, m.binary, rig, repeats);
 }

@@ -49,6 +49,7 @@ struct Variant {
   bool bicubicHistory = DenoiseParams().bicubicHistory;  ///< the denoiser's history read (--denoise-history)
   int iterations = DenoiseParams().iterations;           ///< a-trous passes (--denoise-iterations)
   int directIterations = DenoiseParams().directIterations;  ///< of them, the direct signal's (--denoise-direct-iterations)
+  bool quarterPhotonPasses = DenoiseParams().quarterPhotonPasses;  ///< --denoise-photon-passes quarter
   // The suite's options with this variant's (the moving and the still head both render from it).
   RenderOptions options(const RenderOptions& suite) const {
     RenderOptions o = suite;
@@ -56,6 +57,7 @@ struct Variant {
     o.denoise.params.bicubicHistory = bicubicHistory;
     o.denoise.params.iterations = iterations;
     o.denoise.params.directIterations = directIterations;
+    o.denoise.params.quarterPhotonPasses = quarterPhotonPasses;
     o.temporal.enabled = taa;
     o.stereo = stereo;
     o.photonBatches = photonBatches;
@@ -100,7 +102,14 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                   .photonBatches = 1, .stereo = StereoMode::Gather, .directIterations = 2},
                                  // The cheapest of the controller's denoise steps above 2 passes, under reuse.
                                  {.name = "denoise, 4 passes, direct 2, gather reuse", .denoise = true, .taa = false,
-                                  .photonBatches = 1, .stereo = StereoMode::Gather, .iterations = 4, .directIterations = 2}};
+                                  .photonBatches = 1, .stereo = StereoMode::Gather, .iterations = 4, .directIterations = 2},
+                                 // The photon-map signal's later passes on the even pixels (a quarter), the
+                                 // rest interpolated: against the two rows above.
+                                 {.name = "denoise, direct 2 passes, quarter photon passes", .denoise = true, .taa = false,
+                                  .photonBatches = 1, .directIterations = 2, .quarterPhotonPasses = true},
+                                 {.name = "denoise, 4 passes, direct 2, quarter photon passes, gather reuse", .denoise = true,
+                                  .taa = false, .photonBatches = 1, .stereo = StereoMode::Gather, .iterations = 4,
+                                  .directIterations = 2, .quarterPhotonPasses = true}};
 
 // The variants the run asked for (--quality-variants; all where empty), each checked: the first,
 // "raw", is every ratio's base and always runs.
@@ -339,7 +348,7 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"},
                       {"stereo", stereoModeName(v.stereo)}, {"history", v.bicubicHistory ? "catmull-rom" : "bilinear"},
                       {"denoise_iterations", v.iterations}, {"denoise_direct_iterations", v.directIterations},
-                      {"denoise_ms", dn},
+                      {"denoise_photon_passes", v.quarterPhotonPasses ? "quarter" : "full"}, {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});
     }

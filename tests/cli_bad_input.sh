@@ -73,6 +73,8 @@ expect_error "--denoise-iterations is for --denoise" render cornell --denoise-it
 expect_error "--no-refine is for --denoise" render cornell --no-refine --eye-size 8x8
 expect_error "--denoise-history is for --denoise" render cornell --denoise-history bilinear --eye-size 8x8
 expect_error "--denoise-history must be catmull-rom or bilinear, got 'cubic'" render cornell --denoise --denoise-history cubic --eye-size 8x8
+expect_error "--denoise-photon-passes is for --denoise" render cornell --denoise-photon-passes quarter --eye-size 8x8
+expect_error "--denoise-photon-passes must be full or quarter, got 'half'" render cornell --denoise --denoise-photon-passes half --eye-size 8x8
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations 9 --eye-size 8x8
 expect_error "--denoise-iterations: the denoiser's a-trous passes must be between 0 and 8" render cornell --denoise --denoise-iterations -1 --eye-size 8x8
 expect_error "--denoise-iterations" render cornell --denoise --denoise-iterations two --eye-size 8x8

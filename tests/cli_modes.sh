@@ -39,6 +39,8 @@ expect_render fov "fov_left.png fov_right.png" --foveated --gaze 0.3,0.6
 expect_render fovgather "fovgather_right.png" --foveated --stereo gather
 expect_render fovscatter "fovscatter_right.png" --foveated --stereo scatter --gaze 0.6,0.4
 expect_render taa "taa_0004_left.png taa_0004_right.exr" --taa --trajectory "$data/gaze_pursuit.traj"
+expect_render quarter "quarter_0004_left.png quarter_0004_right.png" --denoise --denoise-photon-passes quarter \
+  --denoise-direct-iterations 2 --stereo gather --trajectory "$data/gaze_pursuit.traj"
 expect_render raster "raster_left.png raster_right.exr" --primary raster --stereo gather
 grep -q "raster pass" "$out/stdout" || { echo "FAIL: no raster pre-pass time printed"; failures=$((failures + 1)); }
 expect_render rasterfov "rasterfov_0000_left.png rasterfov_0004_right.png" --primary raster --foveated --taa --trajectory "$data/gaze_pursuit.traj"

@@ -78,18 +78,26 @@ double maxRelativeError(const Image& out, const std::vector<Vec3>& expected) {
 }
 
 // Also at the magnitudes of physical units (a sun: 1e6) and of a dim scene (1e-6).
+// The default filter, and the photon-map signal's later passes on a quarter of the pixels.
+DenoiseParams quarterPhotonPasses(DenoiseParams params = DenoiseParams()) {
+  params.quarterPhotonPasses = true;
+  return params;
+}
+
 TEST(Denoise, ConstantIrradianceStaysConstantUnderATexture) {
-  for (float magnitude : {1.0f, 1e6f, 1e-6f}) {
-    SyntheticFrame f(64, 48);
-    for (int y = 0; y < 48; ++y)
-      for (int x = 0; x < 64; ++x) f.set(x, y, checker(x, y), Vec3(0.5f) * magnitude, Vec3(0.3f, 0.2f, 0.1f) * magnitude);
-    HostDenoiser denoiser;
-    Image out;
-    for (int frame = 0; frame < 6; ++frame) {
-      denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out);
-      EXPECT_LT(maxRelativeError(out, f.image), 1e-5) << "magnitude " << magnitude << ", frame " << frame;
+  for (const DenoiseParams& params : {DenoiseParams(), quarterPhotonPasses()})
+    for (float magnitude : {1.0f, 1e6f, 1e-6f}) {
+      SyntheticFrame f(64, 48);
+      for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 64; ++x) f.set(x, y, checker(x, y), Vec3(0.5f) * magnitude, Vec3(0.3f, 0.2f, 0.1f) * magnitude);
+      HostDenoiser denoiser;
+      Image out;
+      for (int frame = 0; frame < 6; ++frame) {
+        denoiser.denoise(Eye::Left, f.camera, params, f.inputs(), out);
+        EXPECT_LT(maxRelativeError(out, f.image), 1e-5)
+            << "magnitude " << magnitude << ", frame " << frame << ", quarter " << params.quarterPhotonPasses;
+      }
     }
-  }
 }
 
 TEST(Denoise, NoiseFreeImageIsUnchangedOnceItsHistoryIsLong) {
@@ -100,20 +108,27 @@ TEST(Denoise, NoiseFreeImageIsUnchangedOnceItsHistoryIsLong) {
       f.set(x, y, checker(x, y), Vec3(e), Vec3(0.2f * e + 0.05f));
       if (x > 40 && y > 20 && y < 30) f.direct[f.at(x, y)] = Vec3(0.0f), f.image[f.at(x, y)] = checker(x, y) * 0.1f;  // a hard shadow
     }
-  HostDenoiser denoiser;
-  Image out;
-  for (int frame = 0; frame < 40; ++frame) denoiser.denoise(Eye::Left, f.camera, DenoiseParams(), f.inputs(), out);
   // The first frames (short history, variance from the neighbourhood) blur; their share of the
-  // history falls by 0.8 per frame, and a zero temporal variance stops every tap that differs.
-  EXPECT_LT(maxRelativeError(out, f.image), 2e-3);
+  // history falls by 0.8 per frame, and a zero temporal variance stops every tap that differs
+  // (also the quarter passes' interpolation: the shadow steps the photon-map signal too).
+  for (const DenoiseParams& params : {DenoiseParams(), quarterPhotonPasses()}) {
+    HostDenoiser denoiser;
+    Image out;
+    for (int frame = 0; frame < 40; ++frame) denoiser.denoise(Eye::Left, f.camera, params, f.inputs(), out);
+    EXPECT_LT(maxRelativeError(out, f.image), 2e-3) << "quarter " << params.quarterPhotonPasses;
+  }
 }
 
 // Left half: one surface with noise; right half: another surface (farther, or turned), as bright
 // or 1000 times brighter. The left half must come out the same either way: no left pixel takes
 // any of the right's light, whatever the luminance test says.
-void expectNoBlending(const char* what, float rightDepth, Vec3 rightNormal, float sigmaLuminance) {
+// Under quarter photon passes the edge also lies between an even and an odd column (odd pixels
+// interpolate from both sides).
+void expectNoBlending(const char* what, float rightDepth, Vec3 rightNormal, float sigmaLuminance, bool quarter = false,
+                      int edge = 24) {
   DenoiseParams params;
   params.sigmaLuminance = sigmaLuminance;
+  params.quarterPhotonPasses = quarter;
   Image left[2];
   for (int run = 0; run < 2; ++run) {
     SyntheticFrame f(48, 32);
@@ -121,7 +136,7 @@ void expectNoBlending(const char* what, float rightDepth, Vec3 rightNormal, floa
     std::uniform_real_distribution<float> noise(0.5f, 1.5f);
     for (int y = 0; y < 32; ++y)
       for (int x = 0; x < 48; ++x) {
-        const bool right = x >= 24;
+        const bool right = x >= edge;
         const float value = (right && run == 1 ? 1000.0f : 1.0f) * noise(rng);
         f.set(x, y, Vec3(0.5f), Vec3(value), Vec3(0.1f * value));
         if (right) f.inverseDepth[f.at(x, y)] = 1.0f / rightDepth, f.normal[f.at(x, y)] = rightNormal;
@@ -130,17 +145,20 @@ void expectNoBlending(const char* what, float rightDepth, Vec3 rightNormal, floa
     for (int frame = 0; frame < 3; ++frame) denoiser.denoise(Eye::Left, f.camera, params, f.inputs(), left[run]);
   }
   for (int y = 0; y < 32; ++y)
-    for (int x = 0; x < 24; ++x)
-      ASSERT_EQ(left[0].pixels[size_t(y) * 48 + x], left[1].pixels[size_t(y) * 48 + x]) << what << " at " << x << "," << y;
+    for (int x = 0; x < edge; ++x)
+      ASSERT_EQ(left[0].pixels[size_t(y) * 48 + x], left[1].pixels[size_t(y) * 48 + x])
+          << what << " at " << x << "," << y << ", quarter " << quarter << ", edge " << edge;
 }
 
 TEST(Denoise, SurfacesOfAnotherDepthOrNormalNeverBlend) {
-  for (float sigma : {4.0f, 1e6f}) {  // the default luminance test, and none
-    expectNoBlending("depth edge", 2.5f, Vec3(0, 0, 1), sigma);
-    expectNoBlending("small depth step", 2.1f, Vec3(0, 0, 1), sigma);
-    expectNoBlending("normal edge", 2.0f, Vec3(1, 0, 0), sigma);
-    expectNoBlending("crease", 2.0f, normalize(Vec3(0.5f, 0, 0.866f)), sigma);
-  }
+  for (float sigma : {4.0f, 1e6f})  // the default luminance test, and none
+    for (int quarter = 0; quarter < 2; ++quarter)
+      for (int edge : {24, 25}) {
+        expectNoBlending("depth edge", 2.5f, Vec3(0, 0, 1), sigma, quarter, edge);
+        expectNoBlending("small depth step", 2.1f, Vec3(0, 0, 1), sigma, quarter, edge);
+        expectNoBlending("normal edge", 2.0f, Vec3(1, 0, 0), sigma, quarter, edge);
+        expectNoBlending("crease", 2.0f, normalize(Vec3(0.5f, 0, 0.866f)), sigma, quarter, edge);
+      }
 }
 
 TEST(Denoise, NoiseFallsAndTheMeanStays) {
@@ -348,10 +366,12 @@ DenoiseInputs reusingRightEye(DenoiseInputs own, const std::vector<uint32_t>& re
 TEST(Denoise, ReusedPixelsShareTheLeftEyesFilterAndHistory) {
   // Also where the direct signal stops before the photon map's (its last level, kept by the left
   // eye, is read by the right eye's neighbours at the later passes).
+  // And under quarter photon passes, whose reused taps read the left eye's even pixels.
   DenoiseParams directTwoPasses;
   directTwoPasses.directIterations = 2;
-  for (const DenoiseParams& params : {DenoiseParams(), directTwoPasses}) {
-    SCOPED_TRACE("direct signal's passes " + std::to_string(params.directIterations));
+  for (const DenoiseParams& params : {DenoiseParams(), directTwoPasses, quarterPhotonPasses(directTwoPasses)}) {
+    SCOPED_TRACE("direct signal's passes " + std::to_string(params.directIterations) + ", quarter " +
+                 std::to_string(params.quarterPhotonPasses));
     const int w = 64, h = 48;
     HostDenoiser denoiser;
     Image left, right;
@@ -377,8 +397,14 @@ TEST(Denoise, ReusedPixelsShareTheLeftEyesFilterAndHistory) {
     EXPECT_EQ(denoiser.denoise(Eye::Right, f.camera, params, second.inputs(), right), size_t(w) * h);
     for (size_t i = 0; i < left.pixels.size(); ++i) ASSERT_EQ(right.pixels[i], left.pixels[i]) << "pixel " << i;
 
-    // The left eye must have kept its levels for a reusing right eye.
+    // The left eye must have kept its levels for a reusing right eye (this frame's left eye did
+    // not), and have filtered the same pixels (the last case: the left eye's quarter passes
+    // against a right eye's full ones).
     EXPECT_THROW(denoiser.denoise(Eye::Right, f.camera, params, rightIn, right), Error);
+    denoiser.denoise(Eye::Left, f.camera, params, leftIn, left);
+    DenoiseParams otherPixels = params;
+    otherPixels.quarterPhotonPasses = !params.quarterPhotonPasses;
+    EXPECT_THROW(denoiser.denoise(Eye::Right, f.camera, otherPixels, rightIn, right), Error);
   }
 }
 
@@ -421,22 +447,32 @@ TEST(Denoise, TheDirectSignalTakesOnlyItsPasses) {
 // for bit as without, over frames where the right eye reuses a different third of its pixels each
 // frame (its history then refers to the left eye's), with background beside the surfaces, moving
 // and then refining, with the direct signal through all passes and through two.
+// Under quarter photon passes also with the reused pixels one column, and then one diagonal, from
+// their sources (a disparity of odd pixels: reused taps read the left eye's nearest even pixel).
 TEST(Denoise, NoPassReadsWhatNoFrameWrote) {
   const int w = 48, h = 40;
   DenoiseParams directTwoPasses;
   directTwoPasses.directIterations = 2;
-  for (const DenoiseParams& params : {DenoiseParams(), directTwoPasses}) {
+  struct Case {
+    DenoiseParams params;
+    int shiftX = 0, shiftY = 0;
+  };
+  for (const Case& c : {Case{DenoiseParams()}, Case{directTwoPasses}, Case{quarterPhotonPasses()},
+                        Case{quarterPhotonPasses(directTwoPasses), 1, 0}, Case{quarterPhotonPasses(), 1, 1}}) {
+    const DenoiseParams& params = c.params;
     HostDenoiser clean, poisoned;
     poisoned.poisonUnwritten(true);
     for (int frame = 0; frame < 12; ++frame) {
-      SCOPED_TRACE("direct passes " + std::to_string(params.directIterations) + ", frame " + std::to_string(frame));
+      SCOPED_TRACE("direct passes " + std::to_string(params.directIterations) + ", quarter " +
+                   std::to_string(params.quarterPhotonPasses) + ", shift " + std::to_string(c.shiftX) + "," +
+                   std::to_string(c.shiftY) + ", frame " + std::to_string(frame));
       SyntheticFrame f = noisyPlane(w, h, 60 + unsigned(frame));
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < 6; ++x) f.inverseDepth[f.at(x, y)] = 0.0f, f.image[f.at(x, y)] = Vec3(0.5f);  // sky
       std::vector<uint32_t> reusedFrom(size_t(w) * h, kNotReused);
-      for (int y = 0; y < h; ++y)
-        for (int x = 6; x < w; ++x)
-          if ((x + y + frame) % 3 == 0) reusedFrom[f.at(x, y)] = uint32_t(f.at(x, y));
+      for (int y = c.shiftY; y < h; ++y)
+        for (int x = 6 + c.shiftX; x < w; ++x)
+          if ((x + y + frame) % 3 == 0) reusedFrom[f.at(x, y)] = uint32_t(f.at(x - c.shiftX, y - c.shiftY));
       const int still = frame < 6 ? 0 : frame - 5;
       Image out[2][2];  // [denoiser][eye]
       HostDenoiser* denoisers[2] = {&clean, &poisoned};
@@ -454,6 +490,71 @@ TEST(Denoise, NoPassReadsWhatNoFrameWrote) {
           ASSERT_EQ(c, out[0][e].pixels[i]) << "eye " << e << ", pixel " << i;
         }
     }
+  }
+}
+
+// Quarter photon passes: the photon-map signal's passes after the first run on the even pixels
+// alone, whose taps at steps 2, 4, ... land on even pixels only. Over frames of a noisy plane with
+// a farther surface beside it (its edge on an odd column), moving and then refining, the even
+// pixels come out bit for bit as the full filter gives them (with each level in a buffer of its
+// own, as a left eye under reuse keeps them, and with levels two apart sharing one); the odd ones,
+// interpolated, stay near it and as near the noise-free answer. A right eye reusing a third of its
+// pixels one column and one row off (reused taps read the left eye's nearest even pixel) stays
+// near the full filter's right eye too.
+TEST(Denoise, QuarterPhotonPassesAreTheFullFilterOnTheEvenPixels) {
+  const int w = 64, h = 48;
+  DenoiseParams directTwoPasses, fourPasses;
+  directTwoPasses.directIterations = 2;
+  fourPasses.iterations = 4, fourPasses.directIterations = 2;
+  for (const DenoiseParams& params : {DenoiseParams(), directTwoPasses, fourPasses}) {
+    SCOPED_TRACE("passes " + std::to_string(params.iterations) + ", direct " + std::to_string(params.directIterations));
+    HostDenoiser full, quarter, fullAlone, quarterAlone;
+    double oddDifference = 0, oddLevel = 0, fullError = 0, quarterError = 0, rightDifference = 0, rightLevel = 0;
+    for (int frame = 0; frame < 12; ++frame) {
+      const int still = frame < 8 ? 0 : frame - 7;
+      SyntheticFrame f = noisyPlane(w, h, 200 + unsigned(frame));
+      for (int y = 0; y < h; ++y)
+        for (int x = 41; x < w; ++x) f.inverseDepth[f.at(x, y)] = 1.0f / 3.0f;
+      std::vector<uint32_t> reusedFrom(size_t(w) * h, kNotReused);
+      for (int y = 1; y < h; ++y)
+        for (int x = 1; x < w; ++x)
+          if ((x + 2 * y) % 3 == 0 && (x < 41) == (x - 1 < 41)) reusedFrom[f.at(x, y)] = uint32_t(f.at(x - 1, y - 1));
+      Image out[2][2], alone[2];  // [full, quarter][eye], [full, quarter] without kept levels
+      HostDenoiser* denoisers[2] = {&full, &quarter};
+      HostDenoiser* alones[2] = {&fullAlone, &quarterAlone};
+      for (int d = 0; d < 2; ++d) {
+        DenoiseParams p = params;
+        p.quarterPhotonPasses = d == 1;
+        DenoiseInputs leftIn = f.inputs();
+        leftIn.keepLevels = true;
+        denoisers[d]->denoise(Eye::Left, f.camera, p, leftIn, out[d][0], still);
+        denoisers[d]->denoise(Eye::Right, f.camera, p, reusingRightEye(f.inputs(), reusedFrom, f, out[d][0]), out[d][1],
+                              still);
+        alones[d]->denoise(Eye::Left, f.camera, p, f.inputs(), alone[d], still);
+      }
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const size_t i = f.at(x, y);
+          const double a = luminance(out[0][0].pixels[i]), b = luminance(out[1][0].pixels[i]);
+          if ((x | y) % 2 == 0) {
+            ASSERT_EQ(out[1][0].pixels[i], out[0][0].pixels[i]) << "frame " << frame << " at " << x << "," << y;
+            ASSERT_EQ(alone[1].pixels[i], alone[0].pixels[i]) << "frame " << frame << " at " << x << "," << y;
+          } else {
+            oddDifference += std::fabs(b - a), oddLevel += a;
+          }
+          const double truth = luminance(checker(x, y) * 0.7f);
+          fullError += (a - truth) * (a - truth), quarterError += (b - truth) * (b - truth);
+          rightDifference += std::fabs(double(luminance(out[1][1].pixels[i])) - luminance(out[0][1].pixels[i]));
+          rightLevel += luminance(out[0][1].pixels[i]);
+        }
+    }
+    std::printf("passes %d, direct %d: odd pixels %.4f off the full filter, squared error %.4f of its, right eye %.4f off\n",
+                params.iterations, params.directIterations, oddDifference / oddLevel, quarterError / fullError,
+                rightDifference / rightLevel);
+    EXPECT_GT(oddDifference, 0.0);  // the odd pixels are interpolated, not filtered
+    EXPECT_LT(oddDifference / oddLevel, 0.01);  // 0.1 % (their first-pass output alone: several per cent)
+    EXPECT_LT(quarterError, 1.05 * fullError);
+    EXPECT_LT(rightDifference / rightLevel, 0.01);
   }
 }
 

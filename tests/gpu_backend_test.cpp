@@ -387,13 +387,25 @@ TEST(GpuBackend, DenoisingMatchesTheCpu) {
   BothBackends both("cornell-caustics", 320, 352);
   auto& [scene, rig, cpu, gpu] = both;
   FoveationMask mask = generateFoveationMask(maskParamsForRig(rig));
-  struct Case { const char* name; bool foveated; StereoMode stereo; bool taa; int directIterations = DenoiseParams().directIterations; };
+  struct Case {
+    const char* name;
+    bool foveated;
+    StereoMode stereo;
+    bool taa;
+    int directIterations = DenoiseParams().directIterations;
+    bool quarterPhotonPasses = false;
+  };
   for (const Case& c : {Case{"full", false, StereoMode::Separate, false}, Case{"foveated", true, StereoMode::Separate, false},
                         Case{"gather reuse + TAA", false, StereoMode::Gather, true},
-                        Case{"gather reuse, direct 2 passes", false, StereoMode::Gather, false, 2}}) {
+                        Case{"gather reuse, direct 2 passes", false, StereoMode::Gather, false, 2},
+                        Case{"quarter photon passes", false, StereoMode::Separate, false, 2, true},
+                        Case{"quarter photon passes, direct all passes", false, StereoMode::Separate, false,
+                             DenoiseParams().directIterations, true},
+                        Case{"gather reuse, direct 2 passes, quarter photon passes", false, StereoMode::Gather, false, 2, true}}) {
     RenderOptions o = comparisonOptions();
     o.denoise.enabled = true;
     o.denoise.params.directIterations = c.directIterations;
+    o.denoise.params.quarterPhotonPasses = c.quarterPhotonPasses;
     o.temporal.enabled = c.taa;
     o.stereo = c.stereo;
     o.foveation.mask = c.foveated ? &mask : nullptr;

@@ -106,6 +106,7 @@ struct RenderArgs {
   int denoiseDirectIterations = DenoiseParams().directIterations;
   bool noRefine = false;
   std::string denoiseHistory;  // empty: DenoiseParams' default
+  std::string denoisePhotonPasses;  // empty: DenoiseParams' default
   int photonBatches = 1;     // a rolling photon map's slices, one retraced per frame
   std::string out = "out/render";
   float exposure = 1.0f;
@@ -168,6 +169,7 @@ void applySettings(const std::string& path, RenderArgs& a, const CLI::App& cmd) 
     flag("taa", "--taa", a.taa);
     flag("denoise", "--denoise", a.denoise);
     text("denoise_history", "--denoise-history", a.denoiseHistory);
+    text("denoise_photon_passes", "--denoise-photon-passes", a.denoisePhotonPasses);
     if (j.contains("denoise_iterations") && !given("--denoise-iterations"))
       a.denoiseIterations = jsonNumber<int>(j["denoise_iterations"], "denoise_iterations");
     if (j.contains("denoise_direct_iterations") && !given("--denoise-direct-iterations"))
@@ -273,6 +275,11 @@ void addDenoiseOptions(CLI::App& cmd, RenderArgs& a) {
                  "catmull-rom (sharper: 12 taps where they all saw the surface; on the H100 3 % less error on "
                  "Sponza for 0.22 ms more a stereo frame)")
       ->default_str(DenoiseParams().bicubicHistory ? "catmull-rom" : "bilinear");
+  cmd.add_option("--denoise-photon-passes", a.denoisePhotonPasses,
+                 "Where --denoise's passes after the first filter the photon-map light: full (every pixel) | quarter "
+                 "(the even pixels, exact there; the others interpolated from them on their surface; "
+                 "docs/denoising.md)")
+      ->default_str(DenoiseParams().quarterPhotonPasses ? "quarter" : "full");
   cmd.add_flag("--no-refine", a.noRefine,
                "With --denoise: no progressive refinement while the head is still (averaging still frames with a "
                "shrinking photon radius)");
@@ -412,6 +419,12 @@ RenderOptions optionsFromArgs(const RenderArgs& a, StereoRig& rig) {
     if (a.denoiseHistory != "catmull-rom" && a.denoiseHistory != "bilinear")
       throw Error("--denoise-history must be catmull-rom or bilinear, got '" + a.denoiseHistory + "'");
     options.denoise.params.bicubicHistory = a.denoiseHistory == "catmull-rom";
+  }
+  if (!a.denoisePhotonPasses.empty()) {
+    if (!a.denoise) throw Error("--denoise-photon-passes is for --denoise");
+    if (a.denoisePhotonPasses != "full" && a.denoisePhotonPasses != "quarter")
+      throw Error("--denoise-photon-passes must be full or quarter, got '" + a.denoisePhotonPasses + "'");
+    options.denoise.params.quarterPhotonPasses = a.denoisePhotonPasses == "quarter";
   }
   options.denoise.params.refineWhenStill = !a.noRefine;
   options.denoise.enabled = a.denoise;

@@ -395,9 +395,8 @@ ControlDecision BudgetController::decide(double nowMs) {
     d.change = "start";
   } else if (!settled_) {
     settled_ = true;
-    if (params_.foveationAvailable && measured_.size() >= 3 && measured_[1].second.foveated && !measured_[2].second.foveated &&
-        measured_[1].first.rayMs > 0 && measured_[2].first.rayMs > 0)
-      learnFoveatedRatio(measured_[1].first.rayMs / measured_[2].first.rayMs);
+    if (params_.foveationAvailable && measured_.size() >= 3 && measured_[1].second.foveated && !measured_[2].second.foveated)
+      learnFoveatedRatio(foveatedRatioOf(measured_[1].first, measured_[1].second, measured_[2].first, measured_[2].second));
     units_.erase(units_.begin());
     measured_.erase(measured_.begin());
     while (units_.size() > size_t(params_.window)) units_.erase(units_.begin()), measured_.erase(measured_.begin());
@@ -502,6 +501,19 @@ double BudgetController::margin() const {
   return std::clamp(worst + 0.02, params_.margin, params_.maxMargin);
 }
 
+double BudgetController::foveatedRatioOf(const ControlCosts& foveated, const ControlSetting& foveatedSetting,
+                                         const ControlCosts& full, const ControlSetting& fullSetting) const {
+  // Each frame's eye rays over their scale without the foveated factor: the groups' levels may
+  // differ between the two (at a switch; the start-up's probe frames differ in foveation alone).
+  auto raysPerUnit = [&](double ms, ControlSetting s) {
+    s.foveated = false;
+    const double scale = scaleOf(s).rayMs;
+    return scale > 0 ? ms / scale : 0.0;
+  };
+  const double a = raysPerUnit(foveated.rayMs, foveatedSetting), b = raysPerUnit(full.rayMs, fullSetting);
+  return a > 0 && b > 0 ? a / b : 0.0;
+}
+
 void BudgetController::learnFoveatedRatio(double ratio) {
   if (!(ratio > 0.0) || !finite(ratio)) return;
   profile_.foveatedSamples = std::clamp(ratio, 0.01, 1.0);
@@ -541,15 +553,12 @@ void BudgetController::observe(const ControlCosts& measured) {
   // to where the controller would never switch again.
   bool remeasured = false;
   if (settled_ && !measured_.empty() && measured_.back().second.foveated != current_.foveated) {
-    auto raysPerUnit = [&](double ms, ControlSetting s) {
-      s.foveated = false;
-      return ms / scaleOf(s).rayMs;
-    };
-    const double now = raysPerUnit(measured.rayMs, current_),
-                 before = raysPerUnit(measured_.back().first.rayMs, measured_.back().second);
-    if (now > 0 && before > 0) {
+    const auto& [beforeCosts, beforeSetting] = measured_.back();
+    const double ratio = current_.foveated ? foveatedRatioOf(measured, current_, beforeCosts, beforeSetting)
+                                           : foveatedRatioOf(beforeCosts, beforeSetting, measured, current_);
+    if (ratio > 0) {
       const double old = profile_.foveatedSamples;
-      learnFoveatedRatio(std::clamp(current_.foveated ? now / before : before / now, 0.5 * old, 2.0 * old));
+      learnFoveatedRatio(std::clamp(ratio, 0.5 * old, 2.0 * old));
       remeasured = true;
     }
   }

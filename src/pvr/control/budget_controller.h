@@ -189,6 +189,9 @@ class BudgetController {
   std::vector<std::pair<ControlCosts, ControlSetting>> measured_;
   void unitFrom(ControlCosts& unit, const ControlCosts& measured, const ControlSetting& s);
   void learnFoveatedRatio(double ratio);
+  // The foveated pass's time over the full-resolution one's from a frame of each (0: unknown).
+  double foveatedRatioOf(const ControlCosts& foveated, const ControlSetting& foveatedSetting, const ControlCosts& full,
+                         const ControlSetting& fullSetting) const;
   double margin() const;  ///< the margin now (BudgetControllerParams::margin)
   std::vector<double> overruns_;   ///< the last second's measured / predicted - 1
   double lastPredictedMs_ = 0;

@@ -8,6 +8,7 @@
 #include "pvr/accel/wide_bvh.h"
 #include "pvr/cuda/cuda_stage_clock.h"
 #include "pvr/cuda/denoise.cuh"
+#include "pvr/cuda/device_wide_bvh.h"
 #include "pvr/cuda/display_handover.h"
 #include "pvr/cuda/eye_pass.cuh"
 #include "pvr/cuda/injected_fault.cuh"
@@ -42,15 +43,11 @@ struct CudaFrameBackend::Impl {
   cudaDeviceProp properties{};
   cuda::DeviceScene deviceScene;
   cuda::GpuPhotonTracer tracer;
-  // The photon pass's 8-wide BVH (setPhotonPassBvh), built at first use.
-  struct WidePhotonBvh {
-    cuda::DeviceBuffer<WideBvhNode> nodes;
-    cuda::DeviceBuffer<BvhTriangle> triangles;
-    WideBvhIntersector intersector;
-    bool inUse = false;
-  } wide;
+  // The photon pass's 8-wide BVH (setPhotonPassBvh), uploaded at first use.
+  cuda::DeviceWideBvh wide;
+  bool wideInUse = false;
   uint32_t tracePhotons(const PhotonTraceParams& params) {
-    return wide.inUse ? tracer.trace(deviceScene, wide.intersector, params, stream) : tracer.trace(deviceScene, params, stream);
+    return wideInUse ? tracer.trace(deviceScene, wide.intersector, params, stream) : tracer.trace(deviceScene, params, stream);
   }
   cuda::RollingPhotons rolling;
   bool rollingInUse = false;  ///< the map is built over the rolling slices, not the last trace
@@ -392,20 +389,15 @@ GatherPoint CudaFrameBackend::gatherPointToHost(size_t pixel) {
 const float* CudaFrameBackend::deviceInverseDepth(Eye eye) const { return impl_->eyePass.inverseDepth(eye); }
 void* CudaFrameBackend::deviceStream() const { return impl_->stream; }
 
-void CudaFrameBackend::setPhotonPassBvh(PhotonPassBvh bvh) {
+void CudaFrameBackend::setPhotonPassBvh(PhotonPassBvh bvh, const WideBvh* built) {
   Impl& m = *impl_;
-  if (bvh == PhotonPassBvh::Wide && m.wide.triangles.capacity() == 0 && m.scene.triangleCount() > 0) {
-    const WideBvh built = WideBvh::build(m.scene);
+  if (bvh == PhotonPassBvh::Wide && !m.wide.uploaded && m.scene.triangleCount() > 0) {
     // On the frame's stream: ordered before its photon pass (a non-blocking stream does not wait
     // for the default one).
-    m.wide.nodes.upload(built.nodes().data(), built.nodes().size(), "wide BVH nodes", m.stream);
-    m.wide.triangles.upload(built.triangles().data(), built.triangles().size(), "wide BVH triangles", m.stream);
-    PVR_CUDA_CHECK(cudaStreamSynchronize(m.stream));  // before `built`'s host arrays go out of scope
-    m.wide.intersector.bvh = {m.wide.nodes.data(), m.wide.triangles.data(), uint32_t(built.nodes().size()),
-                              uint32_t(built.triangles().size())};
-    m.wide.intersector.alphaScene = m.deviceScene.intersector.alphaScene;
+    if (built) m.wide.upload(*built, m.deviceScene.intersector.alphaScene, m.stream);
+    else m.wide.upload(WideBvh::build(m.scene), m.deviceScene.intersector.alphaScene, m.stream);
   }
-  m.wide.inUse = bvh == PhotonPassBvh::Wide;
+  m.wideInUse = bvh == PhotonPassBvh::Wide;
 }
 
 std::vector<Photon> CudaFrameBackend::tracePhotonsToHost(const PhotonTraceParams& params) {

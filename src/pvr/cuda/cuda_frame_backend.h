@@ -16,6 +16,7 @@ struct CUstream_st;  // cudaStream_t
 namespace pvr {
 
 class Scene;
+class WideBvh;
 namespace cuda {
 struct DeviceScene;
 }
@@ -65,8 +66,9 @@ class CudaFrameBackend : public FrameBackend {
   void* deviceStream() const override;
 
   // Tools for tests and benchmarks.
-  // Which BVH tracePhotons traces from now on (the 8-wide one is built and uploaded at first use).
-  void setPhotonPassBvh(PhotonPassBvh bvh);
+  // Which BVH tracePhotons traces from now on. The 8-wide one is uploaded at first use: `built`
+  // where given (the scene's, as WideBvh::build makes it), else built here.
+  void setPhotonPassBvh(PhotonPassBvh bvh, const WideBvh* built = nullptr);
   std::vector<Photon> tracePhotonsToHost(const PhotonTraceParams& params);
   // The photons of the map the last frame estimated from, and an eye pass's direct part (shadow
   // rays and emission: the denoiser's guide) in device memory: where a pixel's radiance came from.

@@ -21,13 +21,21 @@ __device__ inline bool blockPixel(const EyeCamera& c, int& x, int& y) {
 
 // At most 64 registers (four blocks an SM): at 80, once the history's taps could refer to the left
 // eye's, the kernel went 199 -> 236 us an eye on Sponza (H100).
+// Under quarter photon passes (`even` set) the filtered pixels are also listed apart by parity.
 __global__ void __launch_bounds__(kBlock * kBlock, 4) accumulateKernel(DenoiseFrameView v, uint32_t* filtered,
-                                                                        unsigned* filteredCount) {
+                                                                        unsigned* counts, uint32_t* even, uint32_t* odd) {
   int x, y;
   const bool inside = blockPixel(v.camera, x, y);
   const size_t pixel = inside ? denoisePixel(v.camera, x, y) : 0;
   if (inside) accumulateDenoisePixel(v, x, y);
-  appendInBlock<kBlock * kBlock>(filtered, filteredCount, inside && filtersPixel(v, pixel), uint32_t(pixel));
+  const bool filters = inside && filtersPixel(v, pixel);
+  appendInBlock<kBlock * kBlock>(filtered, counts, filters, uint32_t(pixel));
+  if (!even) return;  // the same for the whole grid
+  // Each append's shared sums are read to its end: the next may write them only after a barrier.
+  __syncthreads();
+  appendInBlock<kBlock * kBlock>(even, counts + 1, filters && evenPixel(x, y), uint32_t(pixel));
+  __syncthreads();
+  appendInBlock<kBlock * kBlock>(odd, counts + 2, filters && !evenPixel(x, y), uint32_t(pixel));
 }
 
 // The later passes: a grid-stride loop over the listed pixels.
@@ -49,6 +57,11 @@ __global__ void __launch_bounds__(kListThreads, 4)
     atrousKernel(DenoiseFrameView v, int iteration, AtrousLevels levels, const uint32_t* pixels, const unsigned* count) {
   forEachListed(v, pixels, count, [&](int x, int y) { atrousDenoisePixel(v, iteration, levels, x, y); });
 }
+// The same under quarter photon passes, over the even or the odd pixels' list.
+__global__ void __launch_bounds__(kListThreads, 4) atrousQuarterKernel(DenoiseFrameView v, int iteration, AtrousLevels levels,
+                                                                      const uint32_t* pixels, const unsigned* count) {
+  forEachListed(v, pixels, count, [&](int x, int y) { atrousDenoisePixelQuarter(v, iteration, levels, x, y); });
+}
 
 // A full-resolution eye's a-trous pass by tiles. At step s the image splits into s x s lattices of
 // pixels s apart (one per offset); a block takes a 16x16 tile of one lattice, whose 3x3 taps all
@@ -61,6 +74,7 @@ constexpr int kTile = kBlock, kTileRim = kTile + 2;
 
 template <int S>
 struct TileTaps {
+  static constexpr bool kQuarterPhotonPasses = false;  // the first pass only
   const DenoiseGuide (*guides)[kTileRim];
   const ColourVariance (*values)[kTileRim][kTileRim];
   int tx, ty;  ///< the pixel's place in the tile (the rim excluded)
@@ -144,7 +158,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   };
   for (int s = 0; s < signals; ++s) {
     next.colour[s].reserve(pixels, "denoiser history");
-    for (int k = 0; k < EyeState::levelCount(params); ++k) reserveCleared(state.levels[s][EyeState::levelBuffer(k, in)]);
+    for (int k = 0; k < EyeState::levelCount(params, in, s); ++k) reserveCleared(state.levels[s][EyeState::levelBuffer(k, in)]);
   }
   next.moments.reserve(4 * pixels, "denoiser moments");
   next.length.reserve(pixels, "denoiser history length");
@@ -153,17 +167,25 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
   state.depthGradient.reserve(2 * pixels, "denoiser depth gradient");
   state.out.reserve(pixels, "denoised image");
   state.filteredPixels.reserve(pixels, "denoiser pixel list");
-  filteredCount_.reserve(2, "denoiser pixel count");
+  const bool quarter = runsQuarterPhotonPasses(params, in);
+  const size_t evenPixels = size_t((camera.width + 1) / 2) * size_t((camera.height + 1) / 2);
+  if (quarter) {
+    state.evenPixels.reserve(evenPixels, "denoiser even pixel list");
+    state.oddPixels.reserve(pixels - evenPixels, "denoiser odd pixel list");
+  }
+  filteredCount_.reserve(2 * kLists, "denoiser pixel count");
   const DenoiseFrameView v =
       denoiseFrameView(eye, camera, params, in, stillFrames, state, eyes_[int(Eye::Left)], state.out.data());
 
   const dim3 grid(unsigned((camera.width + kBlock - 1) / kBlock), unsigned((camera.height + kBlock - 1) / kBlock));
   const dim3 block(kBlock, kBlock);
   uint32_t* list = state.filteredPixels.data();
-  unsigned* count = filteredCount_.data() + e;
-  // The list's length stays on the device: its passes loop over whatever it holds.
-  PVR_CUDA_CHECK(cudaMemsetAsync(count, 0, sizeof(unsigned), stream));
-  launch("denoise accumulate", accumulateKernel, grid, block, 0, stream, v, list, count);
+  unsigned* count = filteredCount_.data() + kLists * e;
+  uint32_t* even = quarter ? state.evenPixels.data() : nullptr;
+  uint32_t* odd = quarter ? state.oddPixels.data() : nullptr;
+  // The lists' lengths stay on the device: their passes loop over whatever they hold.
+  PVR_CUDA_CHECK(cudaMemsetAsync(count, 0, kLists * sizeof(unsigned), stream));
+  launch("denoise accumulate", accumulateKernel, grid, block, 0, stream, v, list, count, even, odd);
   if (params.iterations == 0) {
     launch("denoise remodulate", remodulateKernel, residentBlocks(remodulateKernel, pixels), kListThreads, 0, stream, v,
            list, count);
@@ -178,6 +200,18 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
     const bool tiles = !in.sampleSpacing && !in.reusedFrom;
     const unsigned atrousBlocks = residentBlocks(atrousKernel, pixels);
     for (int i = 0; i < params.iterations; ++i) {
+      if (i > 0 && quarter) {
+        // The even pixels first: the odd ones' last pass interpolates what theirs wrote.
+        for (AtrousPixels half : {AtrousPixels::Even, AtrousPixels::Odd}) {
+          const AtrousLevels levels = atrousLevels(v, i, half);
+          if (levels.signals == 0 && !levels.upsampled) continue;
+          const bool evens = half == AtrousPixels::Even;
+          launch("denoise a-trous", atrousQuarterKernel,
+                 residentBlocks(atrousQuarterKernel, evens ? evenPixels : pixels - evenPixels), kListThreads, 0, stream, v,
+                 i, levels, evens ? even : odd, count + (evens ? 1 : 2));
+        }
+        continue;
+      }
       const AtrousLevels levels = atrousLevels(v, i);
       if (!tiles || i > 0) {
         launch("denoise a-trous", atrousKernel, atrousBlocks, kListThreads, 0, stream, v, i, levels, list, count);
@@ -196,7 +230,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
 size_t GpuDenoiser::memoryBytes() const {
   size_t bytes = filteredCount_.bytes();
   for (const EyeState& s : eyes_) {
-    bytes += s.depthGradient.bytes() + s.out.bytes() + s.filteredPixels.bytes();
+    bytes += s.depthGradient.bytes() + s.out.bytes() + s.filteredPixels.bytes() + s.evenPixels.bytes() + s.oddPixels.bytes();
     for (const EyeState::History& h : s.history)
       bytes += h.colour[0].bytes() + h.colour[1].bytes() + h.moments.bytes() + h.length.bytes() + h.guide.bytes() +
                h.reusedFrom.bytes();

@@ -22,9 +22,13 @@ class GpuDenoiser {
   struct EyeState : DenoiseEyeState<DeviceBuffer> {
     DeviceBuffer<Vec3> out;
     DeviceBuffer<uint32_t> filteredPixels;  ///< the pixels the eye filters, in 16x16-tile order
+    // Under quarter photon passes, the same split: even pixels (x and y even) and the others.
+    DeviceBuffer<uint32_t> evenPixels, oddPixels;
   };
   EyeState eyes_[2];
-  DeviceBuffer<unsigned> filteredCount_;  ///< per eye, the length of filteredPixels
+  // Per eye: the lengths of filteredPixels, evenPixels and oddPixels.
+  static constexpr int kLists = 3;
+  DeviceBuffer<unsigned> filteredCount_;
 };
 
 }  // namespace pvr::cuda

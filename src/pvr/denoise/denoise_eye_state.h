@@ -25,18 +25,22 @@ struct DenoiseEyeState {
   };
   History history[2];  ///< ping-pong: the last frame's, and the one being written
   int latest = 0, signals = 0;
-  int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels)
+  int keptLevels = 0;  ///< levels of this frame kept apart for the right eye (keepLevels; the last signal's)
+  bool quarterPhotonPasses = false;  ///< this frame ran them (runsQuarterPhotonPasses)
   uint64_t frames = 0;  ///< frames ended
   bool valid = false;
   EyeCamera camera;
   Buffer<float> depthGradient;
-  // Levels 0 .. iterations - 1 (the last pass's output is not kept): two buffers (ping-pong by
-  // the level's parity) unless keepLevels, where level k has buffer k.
+  // Levels 0 .. iterations - 1 (the last pass's output is not kept, but for the photon-map signal's
+  // under quarter photon passes: level `iterations`): two buffers (ping-pong by the level's parity)
+  // unless keepLevels, where level k has buffer k.
   Buffer<ColourVariance> levels[2][kDenoiseLevels];
 
   History& next() { return history[latest ^ 1]; }
-  // Levels a frame writes (level 0 also without a-trous passes), and the buffer of level k.
-  static int levelCount(const DenoiseParams& params) { return std::max(params.iterations, 1); }
+  // Levels a frame writes of signal s (level 0 also without a-trous passes), and the buffer of level k.
+  static int levelCount(const DenoiseParams& params, const DenoiseInputs& in, int s) {
+    return std::max(params.iterations, 1) + (s == 1 && runsQuarterPhotonPasses(params, in) ? 1 : 0);
+  }
   static int levelBuffer(int k, const DenoiseInputs& in) { return in.keepLevels ? k : k & 1; }
   // Starts a frame: a history of another size or number of signals is not read.
   void begin(const EyeCamera& c, const DenoiseInputs& in) {
@@ -54,7 +58,8 @@ struct DenoiseEyeState {
     ++frames;
     camera = c;
     signals = in.direct ? 2 : 1;
-    keptLevels = in.keepLevels ? levelCount(params) : 0;
+    keptLevels = in.keepLevels ? levelCount(params, in, signals - 1) : 0;
+    quarterPhotonPasses = runsQuarterPhotonPasses(params, in);
     valid = true;
   }
 };
@@ -96,21 +101,27 @@ DenoiseFrameView denoiseFrameView(Eye eye, const EyeCamera& camera, const Denois
   v.moments = next.moments.data();
   v.length = next.length.data();
   for (int s = 0; s < signals; ++s) {
-    for (int k = 0; k < State::levelCount(params); ++k) v.levels[s][k] = state.levels[s][State::levelBuffer(k, in)].data();
+    for (int k = 0; k < State::levelCount(params, in, s); ++k) v.levels[s][k] = state.levels[s][State::levelBuffer(k, in)].data();
     v.historyOut[s] = next.colour[s].data();
   }
   v.out = out;
+  v.quarterPhotonPasses = runsQuarterPhotonPasses(params, in);
   if (in.reusedFrom) {
     v.historyReusedFrom = next.reusedFrom.data();
-    if (eye != Eye::Right || !left.valid || left.keptLevels < State::levelCount(params) || left.signals != signals ||
+    if (eye != Eye::Right || !left.valid || left.keptLevels < State::levelCount(params, in, signals - 1) ||
+        left.signals != signals || left.camera.width != camera.width || left.camera.height != camera.height ||
         !in.sourceDenoised)
       throw Error("the right eye's denoise reuses the left eye's, which did not keep its levels this frame");
+    if (left.quarterPhotonPasses != v.quarterPhotonPasses)
+      throw Error("the right eye's denoise reuses the left eye's, which ran its photon-map passes on other pixels");
     const auto& shared = left.history[left.latest];
     for (int s = 0; s < signals; ++s) {
-      for (int k = 0; k < params.iterations; ++k) v.source.levels[s][k] = left.levels[s][k].data();
+      for (int k = 0; k < State::levelCount(params, in, s); ++k) v.source.levels[s][k] = left.levels[s][k].data();
     }
     v.source.moments = shared.moments.data();
     v.source.length = shared.length.data();
+    v.source.quarterPhotonPasses = left.quarterPhotonPasses;
+    v.source.guide = shared.guide.data();
   }
   return v;
 }

@@ -15,6 +15,11 @@ struct DenoiseParams {
   // default: on the H100 it cost 0.22 ms a stereo frame on Sponza for 3 % less error, and
   // nothing on Cornell (docs/benchmarks.md, "The denoiser's history read").
   bool bicubicHistory = false;
+  // The photon-map signal's a-trous passes after the first on the even pixels alone (x and y even:
+  // a quarter of them), whose taps at steps 2, 4, ... land on even pixels only, so the values there
+  // are the full filter's to the bit; the other pixels interpolate the last pass's output from
+  // their even neighbours on the same surface (docs/denoising.md). Off by default until measured.
+  bool quarterPhotonPasses = false;
   // Progressive refinement while the head is still (within the tolerances below from the last
   // frame): the frames' signals are averaged with 1 / n (not the moving head's alpha floor), new
   // photons each frame with a radius shrinking by Knaus-Zwicker's rule (refineAlpha, down to

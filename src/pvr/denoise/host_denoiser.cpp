@@ -38,7 +38,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   };
   for (int s = 0; s < signals; ++s) {
     written(next.colour[s], pixels, unwritten);
-    for (int k = 0; k < EyeState::levelCount(params); ++k) written(state.levels[s][EyeState::levelBuffer(k, in)], pixels, unwritten);
+    for (int k = 0; k < EyeState::levelCount(params, in, s); ++k) written(state.levels[s][EyeState::levelBuffer(k, in)], pixels, unwritten);
   }
   written(next.moments, 4 * pixels, nan);
   written(next.length, pixels, nan);
@@ -54,9 +54,9 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
     if (accumulateDenoisePixel(v, x, y)) used.fetch_add(1, std::memory_order_relaxed);
   });
   // The later passes run over the pixels the eye filters (svgf.h's filtersPixel).
-  auto forEachFiltered = [&](const char* what, const auto& body) {
+  auto forEachFiltered = [&](const char* what, const auto& body, AtrousPixels which = AtrousPixels::All) {
     forEachPixel(what, camera, [&](int x, int y) {
-      if (filtersPixel(v, denoisePixel(camera, x, y))) body(x, y);
+      if (atrousRunsAt(which, x, y) && filtersPixel(v, denoisePixel(camera, x, y))) body(x, y);
     });
   };
   if (params.iterations == 0) {
@@ -64,8 +64,17 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
   } else {
     forEachFiltered("denoise variance", [&](int x, int y) { estimateDenoiseVariance(v, x, y); });
     for (int i = 0; i < params.iterations; ++i) {
-      const AtrousLevels levels = atrousLevels(v, i);
-      forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, levels, x, y); });
+      if (i == 0 || !v.quarterPhotonPasses) {
+        const AtrousLevels levels = atrousLevels(v, i);
+        forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixel(v, i, levels, x, y); });
+        continue;
+      }
+      // The even pixels first: the odd ones' last pass interpolates what theirs wrote.
+      for (AtrousPixels half : {AtrousPixels::Even, AtrousPixels::Odd}) {
+        const AtrousLevels levels = atrousLevels(v, i, half);
+        if (levels.signals == 0 && !levels.upsampled) continue;
+        forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixelQuarter(v, i, levels, x, y); }, half);
+      }
     }
   }
   state.end(camera, params, in, eyes_[int(Eye::Left)]);

@@ -83,6 +83,11 @@ struct DenoiseSharedView {
   const float* moments = nullptr;
   const float* length = nullptr;
   const ColourVariance* levels[2][kDenoiseLevels] = {};
+  // Under quarterPhotonPasses the left eye's photon-map levels after the first exist at its even
+  // pixels only: a reused tap there reads the nearest even pixel on the source's surface (its
+  // guides tell), or else level 1 (the first pass's output, at every pixel).
+  bool quarterPhotonPasses = false;
+  const DenoiseGuide* guide = nullptr;
 };
 
 // One eye's denoising history: the filtered colours, moments, history length and guides of its
@@ -141,8 +146,25 @@ struct DenoiseFrameView {
   uint32_t* historyReusedFrom = nullptr;  ///< a reusing right eye: the next history's reusedFrom
   Vec3* out = nullptr;                             ///< the denoised image
   DenoiseSharedView source;                        ///< the left eye's, where in.reusedFrom is set
+  bool quarterPhotonPasses = false;                ///< runsQuarterPhotonPasses(params, in)
   PVR_HOST_DEVICE int twoSignals() const { return in.direct ? 2 : 1; }
 };
+
+// Whether an eye runs the photon-map signal's passes after the first on its even pixels
+// (DenoiseParams::quarterPhotonPasses): a signal of its own (the direct one filtered apart) and
+// taps a pixel apart. A foveated eye's steps follow its samples' spacing, whose lattice is not
+// the pixels'; it filters as without.
+PVR_HOST_DEVICE inline bool runsQuarterPhotonPasses(const DenoiseParams& params, const DenoiseInputs& in) {
+  return params.quarterPhotonPasses && params.iterations >= 2 && in.direct != nullptr && in.sampleSpacing == nullptr;
+}
+
+// Which pixels an a-trous pass runs over: all, or under quarter photon passes the even ones
+// (x and y even) and then the others.
+enum class AtrousPixels { All, Even, Odd };
+PVR_HOST_DEVICE inline bool evenPixel(int x, int y) { return ((x | y) & 1) == 0; }
+PVR_HOST_DEVICE inline bool atrousRunsAt(AtrousPixels pixels, int x, int y) {
+  return pixels == AtrousPixels::All || (pixels == AtrousPixels::Even) == evenPixel(x, y);
+}
 
 // A pixel's index in an eye's buffers (32 bits: an eye holds fewer than 2^32 pixels, and the
 // a-trous pass's taps keep one register per index instead of two).
@@ -275,6 +297,17 @@ PVR_HOST_DEVICE inline bool filtersPixel(const DenoiseFrameView& v, size_t pixel
   return v.in.inverseDepth[pixel] > 0.0f && reusedSourcePixel(v, pixel) == kNotReused;
 }
 
+// Whether a history pixel whose guide is `g` saw the surface a pixel with `guide` reprojects onto
+// (inverse depth `expected` there).
+PVR_HOST_DEVICE inline bool sameHistoryGuide(const DenoiseGuide& g, float expected, const DenoiseGuide& guide,
+                                             const DenoiseParams& params) {
+  if ((g.inverseDepth > 0.0f) != (expected > 0.0f)) return false;
+  if (expected > 0.0f && !(fabsf(g.inverseDepth - expected) <= params.depthTolerance * fmaxf(g.inverseDepth, expected)))
+    return false;
+  if (isBlack(g.normal) != isBlack(guide.normal)) return false;
+  return isBlack(guide.normal) || dot(g.normal, guide.normal) >= kDenoiseMinNormalCosine;
+}
+
 // The a-trous passes signal s takes. The photon-map signal (and a lone signal) takes every pass:
 // its noise is blotches as wide as the search radius. The direct signal's noise is a shadow ray's
 // per pixel, fine-grained (blue-noise dithered), and the first directIterations passes (at least
@@ -289,29 +322,83 @@ PVR_HOST_DEVICE inline int denoisePasses(const DenoiseParams& params, int signal
 // signal order): the eye's own level, the left eye's same level for reused right pixels, and the
 // next level (none for the last pass, which remodulates). A signal whose passes ended earlier is
 // only added in at the last pass (`finished`, its last level).
+//
+// Under quarter photon passes (pass 1 on, `pixels` Even or Odd) the photon-map signal is a slot of
+// the even pixels' passes only, whose last pass also keeps its output as level `iterations`; the
+// odd pixels' last pass interpolates that (`upsampled`; `fallback`, level 1, the first pass's
+// output, where no even neighbour shares its surface: the later passes write only even pixels, so
+// it is there at the odd ones also when levels two apart share a buffer). A reusing right eye
+// reads the left eye's photon-map levels from pass 2 on, and its last, at the nearest even pixel
+// (`sourceLatticeSlot`; else its level 1, `sourceFallback`).
 struct AtrousLevels {
   int signals = 0;
   const ColourVariance* in[2] = {nullptr, nullptr};
   const ColourVariance* sourceIn[2] = {nullptr, nullptr};
   ColourVariance* out[2] = {nullptr, nullptr};
   const ColourVariance* finished = nullptr;
+  int sourceLatticeSlot = -1;
+  const ColourVariance* upsampled = nullptr;
+  const ColourVariance* sourceUpsampled = nullptr;
+  const ColourVariance* fallback = nullptr;
+  const ColourVariance* sourceFallback = nullptr;
 };
-PVR_HOST_DEVICE inline AtrousLevels atrousLevels(const DenoiseFrameView& v, int iteration) {
+PVR_HOST_DEVICE inline AtrousLevels atrousLevels(const DenoiseFrameView& v, int iteration,
+                                                 AtrousPixels pixels = AtrousPixels::All) {
   AtrousLevels l;
   const int signals = v.twoSignals();
-  const bool last = iteration + 1 >= v.params.iterations;
+  const int iterations = v.params.iterations;
+  const bool last = iteration + 1 >= iterations;
   for (int s = 0; s < signals; ++s) {
     const int passes = denoisePasses(v.params, signals, s);
     if (iteration >= passes) {
       if (last) l.finished = v.levels[s][passes];
       continue;
     }
+    const bool lattice = pixels != AtrousPixels::All && s == 1;  // the photon-map signal, on the even pixels
+    if (lattice && pixels == AtrousPixels::Odd) {
+      if (last) {
+        l.upsampled = v.levels[1][iterations];
+        l.sourceUpsampled = v.source.levels[1][iterations];
+        l.fallback = v.levels[1][1];
+        l.sourceFallback = v.source.levels[1][1];
+      }
+      continue;
+    }
     l.in[l.signals] = v.levels[s][iteration];
     l.sourceIn[l.signals] = v.source.levels[s][iteration];
     if (!last) l.out[l.signals] = v.levels[s][iteration + 1];
+    else if (lattice) l.out[l.signals] = v.levels[1][iterations];
+    if (s == 1 && v.source.quarterPhotonPasses && iteration >= 2) {
+      l.sourceLatticeSlot = l.signals;
+      l.sourceFallback = v.source.levels[1][1];
+    }
     ++l.signals;
   }
   return l;
+}
+
+// The even pixel of the left eye whose photon-map levels stand for its pixel `source` under
+// quarter photon passes: the pixel itself if even, else the first of its even neighbours (2 or 4)
+// on the same surface; false where none is.
+PVR_HOST_DEVICE inline bool latticeSourcePixel(const DenoiseFrameView& v, uint32_t source, uint32_t& at) {
+  const int w = v.camera.width, h = v.camera.height;
+  const int sx = int(source % uint32_t(w)), sy = int(source / uint32_t(w));
+  if (evenPixel(sx, sy)) {
+    at = source;
+    return true;
+  }
+  const DenoiseGuide g = v.source.guide[source];
+  const int nx = sx & 1 ? 2 : 1, ny = sy & 1 ? 2 : 1;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int ex = (sx & ~1) + 2 * i, ey = (sy & ~1) + 2 * j;
+      if (ex >= w || ey >= h) continue;
+      const uint32_t e = denoisePixel(v.camera, ex, ey);
+      if (!sameHistoryGuide(v.source.guide[e], g.inverseDepth, g, v.params)) continue;
+      at = e;
+      return true;
+    }
+  return false;
 }
 
 // Signal s of pixel q at the pass's input level: the eye's own, or for a reused right pixel the
@@ -319,6 +406,18 @@ PVR_HOST_DEVICE inline AtrousLevels atrousLevels(const DenoiseFrameView& v, int 
 PVR_HOST_DEVICE inline const ColourVariance& levelAt(const DenoiseFrameView& v, const AtrousLevels& l, int s, size_t q) {
   const uint32_t source = reusedSourcePixel(v, q);
   return source == kNotReused ? l.in[s][q] : l.sourceIn[s][source];
+}
+// The same under quarter photon passes, where the left eye may have the level at its even pixels
+// only: at the nearest one on that surface, else its level 1 there.
+PVR_HOST_DEVICE inline ColourVariance quarterLevelAt(const DenoiseFrameView& v, const AtrousLevels& l, int s, size_t q) {
+  const uint32_t source = reusedSourcePixel(v, q);
+  if (source == kNotReused) return l.in[s][q];
+  // One load at the end from a chosen level and pixel (choosing between two references made the
+  // GPU keep the levels in a stack frame).
+  const ColourVariance* level = l.sourceIn[s];
+  uint32_t at = source;
+  if (s == l.sourceLatticeSlot && !latticeSourcePixel(v, source, at)) level = l.sourceFallback, at = source;
+  return level[at];
 }
 
 // The pixel's inputs: demodulated signals, albedo and guide.
@@ -342,17 +441,6 @@ PVR_HOST_DEVICE inline void demodulatedInputs(const DenoiseFrameView& v, size_t 
     if (!isFinite(signal[s])) signal[s] = Vec3(0.0f);
   guide.normal = in.normal ? in.normal[pixel] : Vec3(0.0f);
   guide.inverseDepth = in.inverseDepth[pixel];
-}
-
-// Whether a history pixel whose guide is `g` saw the surface a pixel with `guide` reprojects onto
-// (inverse depth `expected` there).
-PVR_HOST_DEVICE inline bool sameHistoryGuide(const DenoiseGuide& g, float expected, const DenoiseGuide& guide,
-                                             const DenoiseParams& params) {
-  if ((g.inverseDepth > 0.0f) != (expected > 0.0f)) return false;
-  if (expected > 0.0f && !(fabsf(g.inverseDepth - expected) <= params.depthTolerance * fmaxf(g.inverseDepth, expected)))
-    return false;
-  if (isBlack(g.normal) != isBlack(guide.normal)) return false;
-  return isBlack(guide.normal) || dot(g.normal, guide.normal) >= kDenoiseMinNormalCosine;
 }
 
 // The history's colours and luminance means at fraction (tx, ty) past pixel (x0, y0) by
@@ -624,11 +712,23 @@ PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.5f : 0.25f;
 // Where an a-trous pass reads the pixel's 3x3 taps (offsets (i, j) in -1..1 of its step; q the
 // tap's pixel): the eye's buffers, as here (the CPU, and the GPU's listed pixels), or a GPU
 // block's tile of them in shared memory (cuda/denoise.cu).
+// Under quarter photon passes (the passes after the first) QuarterMemoryTaps: a reused tap may read
+// the left eye's nearest even pixel, and the odd pixels' last pass adds their interpolated
+// photon-map signal. Apart, so that the full filter's kernels carry none of it (on the GPU the
+// branches cost the list kernel 8 registers and a stack frame).
 struct MemoryTaps {
+  static constexpr bool kQuarterPhotonPasses = false;
   const DenoiseFrameView& v;
   const AtrousLevels& l;
   PVR_HOST_DEVICE DenoiseGuide guide(int, int, size_t q) const { return v.guide[q]; }
   PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const { return levelAt(v, l, s, q); }
+};
+struct QuarterMemoryTaps {
+  static constexpr bool kQuarterPhotonPasses = true;
+  const DenoiseFrameView& v;
+  const AtrousLevels& l;
+  PVR_HOST_DEVICE DenoiseGuide guide(int, int, size_t q) const { return v.guide[q]; }
+  PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const { return quarterLevelAt(v, l, s, q); }
 };
 
 // A 3x3 Gaussian of level 0's variance of signal s around the pixel over its own surface (the
@@ -653,9 +753,48 @@ PVR_HOST_DEVICE inline float blurredVariance(const DenoiseFrameView& v, const Ta
   return sum / total;
 }
 
+// The photon-map signal of an odd pixel after its last pass under quarter photon passes: the mean
+// of its even neighbours' (the pixels beside it on its row or column, or its four diagonal ones)
+// last-pass outputs, each weighed by the passes' own tests: the depth plane and normal, so no
+// other surface's light comes in, and the luminance against the pixel's first-pass output, scaled
+// by the larger standard deviation (noisy: the plain mean; converged: a step in the signal stays
+// sharp). Where none is left (a feature a pixel wide, or a step), its own first-pass output.
+PVR_HOST_DEVICE inline Vec3 upsampledPhotonMap(const DenoiseFrameView& v, const AtrousLevels& l, int x, int y) {
+  const size_t pixel = denoisePixel(v.camera, x, y);
+  const DenoiseGuide p = v.guide[pixel];
+  const ColourVariance own = l.fallback[pixel];
+  const float lp = luminance(own.colour);
+  const float sigma2 = v.params.sigmaLuminance * v.params.sigmaLuminance;
+  const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
+  const int nx = x & 1 ? 2 : 1, ny = y & 1 ? 2 : 1;
+  Vec3 sum(0.0f);
+  float total = 0.0f;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int ex = (x & ~1) + 2 * i, ey = (y & ~1) + 2 * j;
+      if (ex >= v.camera.width || ey >= v.camera.height) continue;
+      const size_t e = denoisePixel(v.camera, ex, ey);
+      float penalty;
+      if (!sameSurface(p, v.guide[e], gx, gy, float(ex - x), float(ey - y), v.params, penalty)) continue;
+      // A reused right pixel's value is the left eye's, at the even pixel standing for it.
+      const uint32_t source = reusedSourcePixel(v, e);
+      uint32_t at = 0;
+      const ColourVariance c = source == kNotReused                 ? l.upsampled[e]
+                               : latticeSourcePixel(v, source, at) ? l.sourceUpsampled[at]
+                                                                   : l.sourceFallback[source];
+      const float inverseScale = filterRsqrt(sigma2 * fmaxf(own.variance, c.variance) + 1e-12f);
+      const float w = filterExp(-penalty - fabsf(luminance(c.colour) - lp) * inverseScale);
+      sum += c.colour * w;
+      total += w;
+    }
+  // (Weights that the tests all but refuse, down to denormals, count as refused.)
+  return total > 1e-6f ? sum / total : own.colour;
+}
+
 // Step 4, a-trous pass `iteration` at a pixel the eye filters: reads level `iteration`, writes the
 // next (and the history after the first pass); the last pass remodulates into `out`. `l` is
-// atrousLevels(v, iteration); `taps` reads the level's values (MemoryTaps, or a GPU tile).
+// atrousLevels(v, iteration, the pixels the pass runs over); `taps` reads the level's values
+// (MemoryTaps, or a GPU tile).
 template <int S, class Taps>
 PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int iteration, const AtrousLevels& l,
                                                  const Taps& taps, int x, int y) {
@@ -731,8 +870,19 @@ PVR_HOST_DEVICE inline void atrousDenoisePixelOf(const DenoiseFrameView& v, int 
     Vec3 radiance = result[0].colour;
     if (signals == 2) radiance += result[signals - 1].colour;
     if (l.finished) radiance += l.finished[pixel].colour;
+    if constexpr (Taps::kQuarterPhotonPasses)
+      if (l.upsampled) radiance += upsampledPhotonMap(v, l, x, y);
     writeDenoised(v, pixel, radiance);
   }
+}
+
+// The last pass of an odd pixel under quarter photon passes whose direct signal's passes ended
+// earlier: nothing left to filter, its photon-map signal interpolated.
+PVR_HOST_DEVICE inline void finishOddPixel(const DenoiseFrameView& v, const AtrousLevels& l, int x, int y) {
+  const size_t pixel = denoisePixel(v.camera, x, y);
+  Vec3 radiance = upsampledPhotonMap(v, l, x, y);
+  if (l.finished) radiance += l.finished[pixel].colour;
+  writeDenoised(v, pixel, radiance);
 }
 
 // Step 5 without a-trous passes (iterations 0), at a pixel the eye filters: level 0 remodulated,
@@ -761,6 +911,15 @@ PVR_HOST_DEVICE inline void atrousDenoisePixel(const DenoiseFrameView& v, int it
   const MemoryTaps taps{v, l};
   if (l.signals == 2) atrousDenoisePixelOf<2>(v, iteration, l, taps, x, y);
   else atrousDenoisePixelOf<1>(v, iteration, l, taps, x, y);
+}
+// A pass after the first under quarter photon passes, at a pixel of the half it runs over
+// (atrousLevels(v, iteration, Even or Odd)).
+PVR_HOST_DEVICE inline void atrousDenoisePixelQuarter(const DenoiseFrameView& v, int iteration, const AtrousLevels& l,
+                                                      int x, int y) {
+  const QuarterMemoryTaps taps{v, l};
+  if (l.signals == 2) atrousDenoisePixelOf<2>(v, iteration, l, taps, x, y);
+  else if (l.signals == 1) atrousDenoisePixelOf<1>(v, iteration, l, taps, x, y);
+  else if (l.upsampled) finishOddPixel(v, l, x, y);
 }
 PVR_HOST_DEVICE inline void remodulateAccumulated(const DenoiseFrameView& v, int x, int y) {
   if (v.twoSignals() == 2) remodulateAccumulatedOf<2>(v, x, y);
