@@ -15,6 +15,7 @@
 #include "pvr/cpu/cpu_frame_backend.h"
 #include "pvr/denoise/host_denoiser.h"
 #include "pvr/image/image_compare.h"
+#include "pvr/photon/density.h"
 #include "pvr/reference/progressive_reference.h"
 #include "pvr/scene/scene.h"
 #include "pvr/util/error.h"
@@ -794,6 +795,9 @@ TEST(DenoiseFrames, AStillHeadRefinesAndAMoveDoesNotPop) {
     Image last;
     for (int frame = 0; frame < 60; ++frame) last = r.render(rig, o).eyes[0].image;
     EXPECT_EQ(r.stillFrames(), refine ? 59 : 0);
+    // Refining, the radius shrinks by Knaus and Zwicker's rule (after 59 still frames to 0.57 of
+    // the first, above its floor).
+    EXPECT_EQ(r.gatherRadius(), refine ? progressiveRadius(0.05f, 59, o.denoise.params.refineAlpha) : 0.05f);
     error[refine] = compareToReference(last, truth).relMse;
     if (refine) still = last;
   }
@@ -805,6 +809,7 @@ TEST(DenoiseFrames, AStillHeadRefinesAndAMoveDoesNotPop) {
   moved.head.position = rig.head.toWorldPoint({0.002f, 0.0f, 0.0f});
   const Image afterMove = refining.render(moved, options).eyes[0].image;
   EXPECT_EQ(refining.stillFrames(), 0);
+  EXPECT_EQ(refining.gatherRadius(), 0.05f);
   refining.resetHistory();
   const Image afterCut = refining.render(moved, options).eyes[0].image;
   const double moveChange = compareImages(afterMove, still), cutChange = compareImages(afterCut, still);

@@ -549,11 +549,7 @@ void expectStillHeadStaysFinite(const std::vector<StillHeadRun>& runs) {
       if (rightBad) {
         const auto [badPixel, badColour] = *rightBad;
         const GatherPoint point = cuda.gatherPointToHost(badPixel);
-        const DenoiseParams& refine = o.denoise.params;
-        const float first = o.gather.density.radius;
-        const float radius = gpu.stillFrames() > 0 ? std::max(progressiveRadius(first, gpu.stillFrames(), refine.refineAlpha),
-                                                              first * refine.minRadiusFraction)
-                                                   : first;
+        const float radius = gpu.gatherRadius();
         Vec3 sum{0, 0, 0};
         size_t within = 0, counted = 0, badContributions = 0, strongestIndex = photons.size();
         float strongestValue = -1.0f;

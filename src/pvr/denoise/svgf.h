@@ -716,20 +716,19 @@ PVR_HOST_DEVICE inline float atrousKernel(int i) { return i == 0 ? 0.5f : 0.25f;
 // the left eye's nearest even pixel, and the odd pixels' last pass adds their interpolated
 // photon-map signal. Apart, so that the full filter's kernels carry none of it (on the GPU the
 // branches cost the list kernel 8 registers and a stack frame).
-struct MemoryTaps {
-  static constexpr bool kQuarterPhotonPasses = false;
+template <bool QuarterPhotonPasses>
+struct MemoryTapsOf {
+  static constexpr bool kQuarterPhotonPasses = QuarterPhotonPasses;
   const DenoiseFrameView& v;
   const AtrousLevels& l;
   PVR_HOST_DEVICE DenoiseGuide guide(int, int, size_t q) const { return v.guide[q]; }
-  PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const { return levelAt(v, l, s, q); }
+  PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const {
+    if constexpr (QuarterPhotonPasses) return quarterLevelAt(v, l, s, q);
+    else return levelAt(v, l, s, q);
+  }
 };
-struct QuarterMemoryTaps {
-  static constexpr bool kQuarterPhotonPasses = true;
-  const DenoiseFrameView& v;
-  const AtrousLevels& l;
-  PVR_HOST_DEVICE DenoiseGuide guide(int, int, size_t q) const { return v.guide[q]; }
-  PVR_HOST_DEVICE ColourVariance value(int s, int, int, size_t q) const { return quarterLevelAt(v, l, s, q); }
-};
+using MemoryTaps = MemoryTapsOf<false>;
+using QuarterMemoryTaps = MemoryTapsOf<true>;
 
 // A 3x3 Gaussian of level 0's variance of signal s around the pixel over its own surface (the
 // luminance test's scale, less noisy; a noisier surface beside it does not loosen it). Its taps are

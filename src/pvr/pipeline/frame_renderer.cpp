@@ -200,6 +200,7 @@ FrameResult FrameRenderer::render(const StereoRig& rig, const RenderOptions& req
     options.gather.density.radius =
         std::max(progressiveRadius(first, stillFrames_, refine.refineAlpha), first * refine.minRadiusFraction);
   }
+  gatherRadius_ = options.gather.density.radius;
   rendered_[0] = rendered_[1] = false;
   FrameBackend& backend = *backend_;
   StageClock& clock = backend.clock();

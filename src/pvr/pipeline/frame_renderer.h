@@ -38,6 +38,8 @@ class FrameRenderer {
   // Frames the view has been still before the last one (the denoiser refines while this grows;
   // 0: it moved, or refinement is off).
   int stillFrames() const { return stillFrames_; }
+  // The photon radius the last frame gathered with (smaller than asked while refining).
+  float gatherRadius() const { return gatherRadius_; }
   // The last frame's displayed image of an eye in GPU memory (linear RGB, row-major, the rig's
   // size), valid until the next frame; null on the CPU backend or for an eye not rendered.
   const Vec3* deviceImage(Eye eye) const;
@@ -63,6 +65,7 @@ class FrameRenderer {
   std::optional<StereoRig> lastRig_;  ///< the last frame's view and options: is this one still?
   RenderOptions lastOptions_;
   int stillFrames_ = 0;
+  float gatherRadius_ = 0.0f;
   bool photonsHeld_ = false;  ///< the backend holds photons traced for lastPhotonOptions_
   RenderOptions lastPhotonOptions_;
   int nextPhotonSlot_ = 0;    ///< the rolling map's slice retraced next
