@@ -204,7 +204,7 @@ void GpuDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoiseParams&
         // The even pixels first: the odd ones' last pass interpolates what theirs wrote.
         for (AtrousPixels half : {AtrousPixels::Even, AtrousPixels::Odd}) {
           const AtrousLevels levels = atrousLevels(v, i, half);
-          if (levels.signals == 0 && !levels.upsampled) continue;
+          if (!levels.runs()) continue;
           const bool evens = half == AtrousPixels::Even;
           launch("denoise a-trous", atrousQuarterKernel,
                  residentBlocks(atrousQuarterKernel, evens ? evenPixels : pixels - evenPixels), kListThreads, 0, stream, v,

@@ -72,7 +72,7 @@ size_t HostDenoiser::denoise(Eye eye, const EyeCamera& camera, const DenoisePara
       // The even pixels first: the odd ones' last pass interpolates what theirs wrote.
       for (AtrousPixels half : {AtrousPixels::Even, AtrousPixels::Odd}) {
         const AtrousLevels levels = atrousLevels(v, i, half);
-        if (levels.signals == 0 && !levels.upsampled) continue;
+        if (!levels.runs()) continue;
         forEachFiltered("denoise a-trous", [&](int x, int y) { atrousDenoisePixelQuarter(v, i, levels, x, y); }, half);
       }
     }

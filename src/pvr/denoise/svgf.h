@@ -341,6 +341,9 @@ struct AtrousLevels {
   const ColourVariance* sourceUpsampled = nullptr;
   const ColourVariance* fallback = nullptr;
   const ColourVariance* sourceFallback = nullptr;
+  // Whether the pass has anything to do at its pixels (an odd pixel's middle pass under quarter
+  // photon passes, the direct signal's passes over, has not).
+  PVR_HOST_DEVICE bool runs() const { return signals > 0 || upsampled != nullptr; }
 };
 PVR_HOST_DEVICE inline AtrousLevels atrousLevels(const DenoiseFrameView& v, int iteration,
                                                  AtrousPixels pixels = AtrousPixels::All) {
@@ -377,28 +380,35 @@ PVR_HOST_DEVICE inline AtrousLevels atrousLevels(const DenoiseFrameView& v, int 
   return l;
 }
 
+// Visits the even pixels beside pixel (x, y) inside the image (the two on its row or column, or its
+// four diagonal ones) until `visit(ex, ey)` returns true; returns whether one did.
+template <class Visit>
+PVR_HOST_DEVICE inline bool forEachEvenNeighbour(const EyeCamera& c, int x, int y, const Visit& visit) {
+  const int nx = x & 1 ? 2 : 1, ny = y & 1 ? 2 : 1;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int ex = (x & ~1) + 2 * i, ey = (y & ~1) + 2 * j;
+      if (ex < c.width && ey < c.height && visit(ex, ey)) return true;
+    }
+  return false;
+}
+
 // The even pixel of the left eye whose photon-map levels stand for its pixel `source` under
 // quarter photon passes: the pixel itself if even, else the first of its even neighbours (2 or 4)
 // on the same surface; false where none is.
 PVR_HOST_DEVICE inline bool latticeSourcePixel(const DenoiseFrameView& v, uint32_t source, uint32_t& at) {
-  const int w = v.camera.width, h = v.camera.height;
-  const int sx = int(source % uint32_t(w)), sy = int(source / uint32_t(w));
+  const int sx = int(source % uint32_t(v.camera.width)), sy = int(source / uint32_t(v.camera.width));
   if (evenPixel(sx, sy)) {
     at = source;
     return true;
   }
   const DenoiseGuide g = v.source.guide[source];
-  const int nx = sx & 1 ? 2 : 1, ny = sy & 1 ? 2 : 1;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int ex = (sx & ~1) + 2 * i, ey = (sy & ~1) + 2 * j;
-      if (ex >= w || ey >= h) continue;
-      const uint32_t e = denoisePixel(v.camera, ex, ey);
-      if (!sameHistoryGuide(v.source.guide[e], g.inverseDepth, g, v.params)) continue;
-      at = e;
-      return true;
-    }
-  return false;
+  return forEachEvenNeighbour(v.camera, sx, sy, [&](int ex, int ey) {
+    const uint32_t e = denoisePixel(v.camera, ex, ey);
+    if (!sameHistoryGuide(v.source.guide[e], g.inverseDepth, g, v.params)) return false;
+    at = e;
+    return true;
+  });
 }
 
 // Signal s of pixel q at the pass's input level: the eye's own, or for a reused right pixel the
@@ -765,27 +775,24 @@ PVR_HOST_DEVICE inline Vec3 upsampledPhotonMap(const DenoiseFrameView& v, const 
   const float lp = luminance(own.colour);
   const float sigma2 = v.params.sigmaLuminance * v.params.sigmaLuminance;
   const float gx = v.depthGradient[2 * pixel], gy = v.depthGradient[2 * pixel + 1];
-  const int nx = x & 1 ? 2 : 1, ny = y & 1 ? 2 : 1;
   Vec3 sum(0.0f);
   float total = 0.0f;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int ex = (x & ~1) + 2 * i, ey = (y & ~1) + 2 * j;
-      if (ex >= v.camera.width || ey >= v.camera.height) continue;
-      const size_t e = denoisePixel(v.camera, ex, ey);
-      float penalty;
-      if (!sameSurface(p, v.guide[e], gx, gy, float(ex - x), float(ey - y), v.params, penalty)) continue;
-      // A reused right pixel's value is the left eye's, at the even pixel standing for it.
-      const uint32_t source = reusedSourcePixel(v, e);
-      uint32_t at = 0;
-      const ColourVariance c = source == kNotReused                 ? l.upsampled[e]
-                               : latticeSourcePixel(v, source, at) ? l.sourceUpsampled[at]
-                                                                   : l.sourceFallback[source];
-      const float inverseScale = filterRsqrt(sigma2 * fmaxf(own.variance, c.variance) + 1e-12f);
-      const float w = filterExp(-penalty - fabsf(luminance(c.colour) - lp) * inverseScale);
-      sum += c.colour * w;
-      total += w;
-    }
+  forEachEvenNeighbour(v.camera, x, y, [&](int ex, int ey) {
+    const size_t e = denoisePixel(v.camera, ex, ey);
+    float penalty;
+    if (!sameSurface(p, v.guide[e], gx, gy, float(ex - x), float(ey - y), v.params, penalty)) return false;
+    // A reused right pixel's value is the left eye's, at the even pixel standing for it.
+    const uint32_t source = reusedSourcePixel(v, e);
+    uint32_t at = 0;
+    const ColourVariance c = source == kNotReused                 ? l.upsampled[e]
+                             : latticeSourcePixel(v, source, at) ? l.sourceUpsampled[at]
+                                                                 : l.sourceFallback[source];
+    const float inverseScale = filterRsqrt(sigma2 * fmaxf(own.variance, c.variance) + 1e-12f);
+    const float w = filterExp(-penalty - fabsf(luminance(c.colour) - lp) * inverseScale);
+    sum += c.colour * w;
+    total += w;
+    return false;  // every neighbour
+  });
   // (Weights that the tests all but refuse, down to denormals, count as refused.)
   return total > 1e-6f ? sum / total : own.colour;
 }
