@@ -34,6 +34,7 @@ struct FrameBenchArgs {
   int referencePasses = 64;   ///< tables, scenes and quality suites: passes of the progressive reference (1024x1024 photons each)
   std::string qualityScenes = "cornell,scenes/dabrovic-sponza.json";  ///< quality suite
   std::string qualityImages;  ///< quality suite: PNG prefix (empty: none)
+  bool qualityStill = true;   ///< quality suite: the still head's 450 frames too (--no-quality-still: the moving head's alone)
   std::string qualityVariants;  ///< quality suite: variant names separated by ';' (empty: all)
   std::string effectsScenes = "cornell-caustics,cornell-dense,scenes/dabrovic-sponza.json,scenes/sibenik.json";  ///< effects suite
   std::string profileOut;     ///< effects suite: the controller's calibrated profiles; controller suite: with the walk's quality model; PREFIX_<scene>.json (empty: none)

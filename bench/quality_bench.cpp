@@ -50,6 +50,7 @@ struct Variant {
   int iterations = DenoiseParams().iterations;           ///< a-trous passes (--denoise-iterations)
   int directIterations = DenoiseParams().directIterations;  ///< of them, the direct signal's (--denoise-direct-iterations)
   bool quarterPhotonPasses = DenoiseParams().quarterPhotonPasses;  ///< --denoise-photon-passes quarter
+  float historyAlpha = DenoiseParams().colourAlpha;  ///< the colour's and the moments' least weight of the current frame
   // The suite's options with this variant's (the moving and the still head both render from it).
   RenderOptions options(const RenderOptions& suite) const {
     RenderOptions o = suite;
@@ -58,6 +59,7 @@ struct Variant {
     o.denoise.params.iterations = iterations;
     o.denoise.params.directIterations = directIterations;
     o.denoise.params.quarterPhotonPasses = quarterPhotonPasses;
+    o.denoise.params.colourAlpha = o.denoise.params.momentsAlpha = historyAlpha;
     o.temporal.enabled = taa;
     o.stereo = stereo;
     o.photonBatches = photonBatches;
@@ -109,7 +111,11 @@ constexpr Variant kVariants[] = {{"raw", false, false, 1},
                                   .photonBatches = 1, .directIterations = 2, .quarterPhotonPasses = true},
                                  {.name = "denoise, 4 passes, direct 2, quarter photon passes, gather reuse", .denoise = true,
                                   .taa = false, .photonBatches = 1, .stereo = StereoMode::Gather, .iterations = 4,
-                                  .directIterations = 2, .quarterPhotonPasses = true}};
+                                  .directIterations = 2, .quarterPhotonPasses = true},
+                                 // A longer temporal average (the history's least weight 0.1 instead of 0.2, the
+                                 // moments' too): less flicker for more lag (docs/denoising.md).
+                                 {.name = "denoise, history alpha 0.1", .denoise = true, .taa = false, .photonBatches = 1,
+                                  .historyAlpha = 0.1f}};
 
 // The variants the run asked for (--quality-variants; all where empty), each checked: the first,
 // "raw", is every ratio's base and always runs.
@@ -348,12 +354,14 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
                       {"boundary", v.boundary == Boundary::Clipped ? "clipped" : "sphere"},
                       {"stereo", stereoModeName(v.stereo)}, {"history", v.bicubicHistory ? "catmull-rom" : "bilinear"},
                       {"denoise_iterations", v.iterations}, {"denoise_direct_iterations", v.directIterations},
-                      {"denoise_photon_passes", v.quarterPhotonPasses ? "quarter" : "full"}, {"denoise_ms", dn},
+                      {"denoise_photon_passes", v.quarterPhotonPasses ? "quarter" : "full"},
+                      {"history_alpha", v.historyAlpha}, {"denoise_ms", dn},
                       {"frame_ms", fr}, {"reference_passes", args.referencePasses},
                       {"reference_estimated_rel_mse_max", worstEstimate}, {"check", ok ? "ok" : "MISMATCH"}});
     }
 
     // Still head.
+    if (!args.qualityStill) continue;
     Image still[2];
     double estimated[2];
     reference(start.head, 4 * args.referencePasses, still, estimated);

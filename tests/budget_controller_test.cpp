@@ -312,12 +312,15 @@ TEST(BudgetController, FittedErrorsReproduceTheMeasuredModel) {
   truth.radiusError = {0.011, 0.0, 0.002};
   truth.denoiseError = {0.0, -0.004, -0.009, -0.010, -0.0105};
   truth.foveatedError = 0.037;
+  truth.photonErrorUndenoised = {0.4, 0.3, 0.2, 0.1, 0.06, 0.02, 0.0};
+  truth.radiusErrorUndenoised = {0.05, 0.0, 0.02};  // 0 at the top's steps, as fitted
   truth.levelError = {{0.21, 0.05, 0.02, 0.0}, {0.13, 0.03, 0.01, 0.0}};
   const BudgetController measured(truth, paramsFor(kFrameMs), RenderOptions(), &kMask);
   ControlProfile fitted = twoGroups();  // the generic model's errors, to be replaced
   int calls = 0;
   fitted.fitErrors(measured.best(), [&](const ControlSetting& s) { return ++calls, measured.predictError(s); });
-  EXPECT_EQ(calls, 1 + 6 + 2 + 4 + 1 + 2 * 3);  // the top, and each other step alone
+  // The top, each other step alone, and the photon and radius steps again without the denoiser.
+  EXPECT_EQ(calls, 1 + 6 + 2 + 4 + 1 + 2 * 3 + 6 + 2);
   fitted.validate();
   const BudgetController model(fitted, paramsFor(kFrameMs), RenderOptions(), &kMask);
   EXPECT_EQ(model.best(), measured.best());
@@ -333,6 +336,57 @@ TEST(BudgetController, FittedErrorsReproduceTheMeasuredModel) {
   EXPECT_EQ(noisy.photonError[5], 0.0);
   EXPECT_EQ(noisy.levelError[1][size_t(EffectLevel::Shadows)], 0.0);
   EXPECT_NEAR(noisy.photonError[4], truth.photonError[4], 1e-12);
+}
+
+// The photon knobs with and without the denoiser: the same step costs more undenoised (the
+// Sponza walk's fit: 512^2 photons without denoising 0.048, the denoised steps' sum 0.025), so a
+// model that adds the denoised steps to the denoiser's own term picks too few photons without it.
+TEST(BudgetController, FewerPhotonsCostMoreWithoutTheDenoiser) {
+  ControlProfile p = twoGroups();
+  p.topError = 0.008;
+  p.photonError = {0.021, 0.010, 0.005, 0.0025, 0.001, 0.0004, 0.0};
+  p.radiusError = {0.0006, 0.0001, 0.0};
+  p.denoiseError = {0.0, -0.0055, -0.0058, -0.0059, -0.0060};  // the cheapest step gives most of the gain
+  const ControlProfile additive = p;
+  p.photonErrorUndenoised = {0.16, 0.08, 0.04, 0.026, 0.013, 0.006, 0.0};
+  p.radiusErrorUndenoised = {0.09, 0.03, 0.0};
+  p.validate();
+  EXPECT_DOUBLE_EQ(p.undenoisedWeight(0), 1.0);
+  EXPECT_DOUBLE_EQ(p.undenoisedWeight(4), 0.0);
+  EXPECT_DOUBLE_EQ(p.undenoisedWeight(2), (-0.0058 + 0.0060) / 0.0060);
+  EXPECT_DOUBLE_EQ(additive.undenoisedWeight(0), 0.0);  // no undenoised ladder: the additive model
+  const BudgetController with(p, paramsFor(kFrameMs), RenderOptions(), &kMask);
+  const BudgetController without(additive, paramsFor(kFrameMs), RenderOptions(), &kMask);
+  ControlSetting off = with.best(), on = with.best();
+  off.denoise = 0, off.photons = 3;  // 362^2 photons, no denoiser
+  on.denoise = 1, on.photons = 1;    // 181^2 photons, the cheapest denoise step
+  // Every step at the best denoiser is the same in both models; without it, the measured ladders.
+  for (const ControlSetting& s : everySetting(p, true)) {
+    if (s.denoise != with.best().denoise) continue;
+    ASSERT_DOUBLE_EQ(with.predictError(s), without.predictError(s));
+  }
+  ControlSetting undenoisedTop = with.best();
+  undenoisedTop.denoise = 0;
+  ControlSetting fewer = undenoisedTop;
+  fewer.photons = 3, fewer.radius = 1;
+  EXPECT_NEAR(with.predictError(fewer) - with.predictError(undenoisedTop), 0.026 + 0.03, 1e-12);  // both groups at gi
+  // The additive model prefers dropping the denoiser to dropping photons; the measured one, not.
+  EXPECT_LT(without.predictError(off), without.predictError(on));
+  EXPECT_GT(with.predictError(off), with.predictError(on));
+  // The ladders round-trip through a profile file, and one of the wrong length is refused.
+  const ControlProfile again = [&] {
+    const std::string path = testing::TempDir() + "undenoised_profile.json";
+    std::ofstream(path) << p.toJson().dump();
+    return ControlProfile::load(path, {"rest", "floor"});
+  }();
+  EXPECT_EQ(again.photonErrorUndenoised, p.photonErrorUndenoised);
+  EXPECT_EQ(again.radiusErrorUndenoised, p.radiusErrorUndenoised);
+  ControlProfile bad = p;
+  bad.radiusErrorUndenoised.pop_back();
+  EXPECT_THROW(bad.validate(), Error);
+  bad = p;
+  bad.radiusErrorUndenoised.clear();
+  EXPECT_THROW(bad.validate(), Error);
 }
 
 TEST(BudgetController, OptionsCarryTheSetting) {

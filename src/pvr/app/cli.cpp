@@ -905,6 +905,8 @@ int runCli(int argc, char** argv, CliRun run) {
       ->capture_default_str();
   bench->add_option("--quality-variants", fa.qualityVariants,
                     "Quality suite: the variants to run, by name, separated by ';' (\"raw\", every ratio's base, always runs)");
+  bench->add_flag("!--no-quality-still", fa.qualityStill,
+                  "Quality suite: the moving head's rows alone, without the still head's 450 frames a variant");
   bench->add_option("--quality-images", fa.qualityImages,
                     "Quality suite: write PNGs (the left eye's central 480x480) of a sampled frame of each variant and its reference to PREFIX_*.png");
   bench->add_option("--effects-scenes", fa.effectsScenes, "Scenes of the effects suite (absent meshes are skipped)")

@@ -120,6 +120,10 @@ void ControlProfile::validate() const {
   if (photonError.size() != photonSides.size() || radiusError.size() != radiusScales.size() ||
       denoiseError.size() != denoiseIterations.size())
     throw Error("each ladder needs one error per step");
+  if (photonErrorUndenoised.empty() != radiusErrorUndenoised.empty() ||
+      (!photonErrorUndenoised.empty() &&
+       (photonErrorUndenoised.size() != photonSides.size() || radiusErrorUndenoised.size() != radiusScales.size())))
+    throw Error("the undenoised photon and radius errors need one error per step, both or neither");
   if (levelError.size() != g || levelRayCost.size() != g || densityShare.size() != g)
     throw Error("level errors, level costs and density shares need one entry per group");
   auto check = [](double v, const char* what) {
@@ -134,6 +138,8 @@ void ControlProfile::validate() const {
   for (double v : photonError) check(v, "photon errors");
   for (double v : radiusError) check(v, "radius errors");
   for (double v : denoiseError) check(v, "denoise errors");
+  for (double v : photonErrorUndenoised) check(v, "undenoised photon errors");
+  for (double v : radiusErrorUndenoised) check(v, "undenoised radius errors");
   for (size_t i = 0; i < g; ++i) {
     for (double v : levelError[i]) check(v, "level errors");
     for (double v : levelRayCost[i]) check(v, "level costs");
@@ -144,6 +150,14 @@ void ControlProfile::validate() const {
 double ControlProfile::denoisePasses(int step) const {
   const int n = denoiseIterations[size_t(step)], direct = denoiseDirectIterations[size_t(step)];
   return double(direct) + photonMapPassShare * double(n - direct);
+}
+
+double ControlProfile::undenoisedWeight(int step) const {
+  if (photonErrorUndenoised.empty() || denoiseIterations.front() != 0) return 0.0;
+  const double best = *std::min_element(denoiseError.begin(), denoiseError.end());
+  const double gain = denoiseError.front() - best;
+  if (!(gain > 0.0)) return 0.0;
+  return std::clamp((denoiseError[size_t(step)] - best) / gain, 0.0, 1.0);
 }
 
 void ControlProfile::fitErrors(const ControlSetting& top, const std::function<double(const ControlSetting&)>& errorOf) {
@@ -162,6 +176,21 @@ void ControlProfile::fitErrors(const ControlSetting& top, const std::function<do
   for (double& e : denoiseError) e -= none;
   topError = topMeasured + none;
   foveatedError = step([](ControlSetting& s) { s.foveated = true; });
+  photonErrorUndenoised.clear(), radiusErrorUndenoised.clear();
+  if (denoiseIterations.front() == 0 && top.denoise != 0) {
+    // The same ladders from the top with the denoiser off (measured above: topMeasured + none).
+    const double undenoised = topMeasured + none;
+    auto off = [&](auto change) {
+      ControlSetting s = top;
+      s.denoise = 0;
+      change(s);
+      return errorOf(s) - undenoised;
+    };
+    for (size_t i = 0; i < photonSides.size(); ++i)
+      photonErrorUndenoised.push_back(int(i) == top.photons ? 0.0 : std::max(0.0, off([&](ControlSetting& s) { s.photons = int(i); })));
+    for (size_t i = 0; i < radiusScales.size(); ++i)
+      radiusErrorUndenoised.push_back(int(i) == top.radius ? 0.0 : off([&](ControlSetting& s) { s.radius = int(i); }));
+  }
   for (size_t g = 0; g < groups.size(); ++g)
     for (int level = 0; level < kControlledLevels; ++level)
       levelError[g][size_t(level)] =
@@ -188,6 +217,8 @@ ControlProfile ControlProfile::load(const std::string& path, const std::vector<s
     p.photonError = readList<double>(err, "photons", {});
     p.radiusError = readList<double>(err, "radius", {});
     p.denoiseError = readList<double>(err, "denoise", {});
+    p.photonErrorUndenoised = readList<double>(err, "photons_undenoised", {});
+    p.radiusErrorUndenoised = readList<double>(err, "radius_undenoised", {});
     p.foveatedError = err.at("foveated").get<double>();
     p.foveatedSamples = cost.at("foveated_samples").get<double>();
     p.denoiseMsPerIteration = cost.value("denoise_ms_per_iteration", p.denoiseMsPerIteration);
@@ -225,6 +256,7 @@ nlohmann::json ControlProfile::toJson() const {
           {"denoise_iterations", denoiseIterations},
           {"denoise_direct_iterations", denoiseDirectIterations},
           {"error", {{"top", topError}, {"photons", photonError}, {"radius", radiusError}, {"denoise", denoiseError},
+                     {"photons_undenoised", photonErrorUndenoised}, {"radius_undenoised", radiusErrorUndenoised},
                      {"foveated", foveatedError}, {"groups", errGroups}}},
           {"cost", {{"groups", costGroups}, {"density_share", shares}, {"foveated_samples", foveatedSamples},
                     {"denoise_ms_per_iteration", denoiseMsPerIteration}, {"photon_map_pass_share", photonMapPassShare},
@@ -330,8 +362,12 @@ double BudgetController::predictError(const ControlSetting& s) const {
     e += profile_.levelError[size_t(g)][size_t(level)];
     if (level == int(EffectLevel::Gi)) giShare += profile_.densityShare[size_t(g)];
   }
-  // The photon knobs matter where photons are gathered.
-  e += giShare * (profile_.photonError[size_t(s.photons)] + profile_.radiusError[size_t(s.radius)]);
+  // The photon knobs matter where photons are gathered, and more the less the denoiser filters.
+  double photonTerms = profile_.photonError[size_t(s.photons)] + profile_.radiusError[size_t(s.radius)];
+  if (const double w = profile_.undenoisedWeight(s.denoise); w > 0.0)
+    photonTerms += w * (profile_.photonErrorUndenoised[size_t(s.photons)] + profile_.radiusErrorUndenoised[size_t(s.radius)] -
+                        photonTerms);
+  e += giShare * photonTerms;
   if (s.foveated) e += profile_.foveatedError;
   return std::max(e, 1e-9);
 }

@@ -13,7 +13,9 @@
 // the last few frames times its scales: the view's cost is tracked as it changes, settings are
 // compared on equal terms.
 // Quality model: each knob's added error (relMSE against the converged reference) measured alone
-// at a calibration view, summed (ControlProfile; `bench --suite effects --profile-out` makes one).
+// at a calibration view, summed (ControlProfile; `bench --suite effects --profile-out` makes one),
+// but for the photon count and radius, whose steps are measured both with the best denoiser and
+// without one, and mixed per denoise step: the denoiser hides most of their noise.
 // It starts by probing the view for two frames at the fewest photons (the first frame's
 // allocations are not counted), foveated where a mask is available, and a third at full
 // resolution: the two give the foveated eye rays' time over the full-resolution ones' at this
@@ -69,6 +71,13 @@ struct ControlProfile {
   double topError = 0.02;
   std::vector<double> photonError, radiusError, denoiseError;  ///< one per ladder step
   double foveatedError = 0.01;
+  // The photon and radius steps' errors again with the denoiser off (empty: as with it). The
+  // denoiser hides most of the photon map's noise, so without it fewer photons or a smaller radius
+  // cost far more: on the H100's Sponza walk 512^2 photons undenoised gave relMSE 0.048 where the
+  // denoised steps added up to 0.025. A denoise step takes the two ladders mixed by how much of the
+  // best step's gain it gives up (undenoisedWeight). Relative to the best photon and radius
+  // steps with the denoiser off (0 there), as fitErrors measures them.
+  std::vector<double> photonErrorUndenoised, radiusErrorUndenoised;
   std::vector<std::array<double, kControlledLevels>> levelError;  ///< per group, per level (gi: 0)
   // Cost shapes: eye-ray time of each group's level relative to all at gi (whose eye rays are
   // 1), the share of the density work each group's gather points do, the foveated eye pass's time
@@ -86,10 +95,17 @@ struct ControlProfile {
   double photonMapPassShare = 0.78;
   // A denoise step's cost in passes over both signals (the denoise cost's scale).
   double denoisePasses(int step) const;
+  // The share of the undenoised photon and radius errors at a denoise step: 1 with the denoiser
+  // off, 0 at the step of least error (where the ladders were measured), in between the share of
+  // that step's gain over no denoiser that the step gives up. 0 wherever no undenoised ladder is
+  // known.
+  double undenoisedWeight(int step) const;
   // Sets the quality model from measurements: `errorOf(setting)` is the relMSE a setting gives
   // (at one view, or the mean over a walk's reference views). `top` (the best setting) and each
   // knob's step from it alone are measured; the terms are the differences, the denoiser's relative
-  // to no denoiser, photon and level steps never below 0. Costs are left as they are.
+  // to no denoiser, photon and level steps never below 0. Where the ladder has the denoiser off
+  // and the top has it on, the photon and radius steps are measured once more without it, from
+  // the top with the denoiser off. Costs are left as they are.
   void fitErrors(const ControlSetting& top, const std::function<double(const ControlSetting&)>& errorOf);
 
   // The generic model for a scene with these groups: variance ~ 1 / (photons x radius^2), bias ~

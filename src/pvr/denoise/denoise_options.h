@@ -18,7 +18,8 @@ struct DenoiseParams {
   // The photon-map signal's a-trous passes after the first on the even pixels alone (x and y even:
   // a quarter of them), whose taps at steps 2, 4, ... land on even pixels only, so the values there
   // are the full filter's to the bit; the other pixels interpolate the last pass's output from
-  // their even neighbours on the same surface (docs/denoising.md). Off by default until measured.
+  // their even neighbours on the same surface (docs/denoising.md). Off: on the H100 it was slower
+  // than the full filter (strided reads of the even pixels), the CPU's passes take half the time.
   bool quarterPhotonPasses = false;
   // Progressive refinement while the head is still (within the tolerances below from the last
   // frame): the frames' signals are averaged with 1 / n (not the moving head's alpha floor), new
