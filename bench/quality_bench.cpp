@@ -361,7 +361,10 @@ int runQuality(const FrameBenchArgs& args, BackendKind kind, nlohmann::json& jso
     }
 
     // Still head.
-    if (!args.qualityStill) continue;
+    if (!args.qualityStill) {
+      std::printf("\n");
+      continue;
+    }
     Image still[2];
     double estimated[2];
     reference(start.head, 4 * args.referencePasses, still, estimated);

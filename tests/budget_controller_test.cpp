@@ -327,6 +327,21 @@ TEST(BudgetController, FittedErrorsReproduceTheMeasuredModel) {
   for (const ControlSetting& s : everySetting(fitted, true))
     ASSERT_NEAR(model.predictError(s), measured.predictError(s), 1e-12);
 
+  // Ladders measured at a denoise step other than the least-error one (the previous profile's
+  // best, where the walk then finds another step better): the mix is anchored where they were
+  // measured, and the fit still gives back the model it measured.
+  ControlProfile truthAt3 = truth;
+  truthAt3.laddersDenoiseStep = 3;
+  const BudgetController measuredAt3(truthAt3, paramsFor(kFrameMs), RenderOptions(), &kMask);
+  ControlSetting top3 = measuredAt3.best();
+  top3.denoise = 3;
+  ControlProfile fittedAt3 = twoGroups();
+  fittedAt3.fitErrors(top3, [&](const ControlSetting& s) { return measuredAt3.predictError(s); });
+  EXPECT_EQ(fittedAt3.laddersDenoiseStep, 3);
+  const BudgetController modelAt3(fittedAt3, paramsFor(kFrameMs), RenderOptions(), &kMask);
+  for (const ControlSetting& s : everySetting(fittedAt3, true))
+    ASSERT_NEAR(modelAt3.predictError(s), measuredAt3.predictError(s), 1e-12);
+
   // A measured photon or level step below the top's error (noise) is no gain in the model.
   ControlProfile noisy = twoGroups();
   noisy.fitErrors(measured.best(), [&](const ControlSetting& s) {
@@ -386,6 +401,12 @@ TEST(BudgetController, FewerPhotonsCostMoreWithoutTheDenoiser) {
   EXPECT_THROW(bad.validate(), Error);
   bad = p;
   bad.radiusErrorUndenoised.clear();
+  EXPECT_THROW(bad.validate(), Error);
+  bad = p;
+  bad.denoiseIterations = {2, 4, 5, 5, 5}, bad.denoiseDirectIterations = {2, 2, 2, 3, 5};  // no step without the denoiser
+  EXPECT_THROW(bad.validate(), Error);
+  bad = p;
+  bad.laddersDenoiseStep = 5;
   EXPECT_THROW(bad.validate(), Error);
 }
 

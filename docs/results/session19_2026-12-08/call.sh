@@ -14,5 +14,11 @@ for phase in "$@"; do
     LIMIT=$(left) bash docs/results/session17_2026-12-07/call.sh "$phase" ;;
   scenes)  # README's cathedral times and issue 13's targets: the scenes suite
     bash docs/results/nan_root_2026-12-07/call.sh scenes ;;
+  quality_sponza)  # owed by `quarter` (cut there): Sponza's quality rows, with the longer history's
+    ( source scripts/device-env.sh
+      step quality_sponza $(($(left) - 20)) stdbuf -oL .gpu/run.sh .gpu/bin/photonvr bench --suite quality --backend cuda \
+        --quality-scenes scenes/dabrovic-sponza.json --no-quality-still \
+        --quality-variants "denoise;denoise, history alpha 0.1;denoise, 4 passes, direct 2, gather reuse" \
+        --json $results/quality_sponza.json ) ;;
   esac
 done

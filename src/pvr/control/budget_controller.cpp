@@ -124,6 +124,10 @@ void ControlProfile::validate() const {
       (!photonErrorUndenoised.empty() &&
        (photonErrorUndenoised.size() != photonSides.size() || radiusErrorUndenoised.size() != radiusScales.size())))
     throw Error("the undenoised photon and radius errors need one error per step, both or neither");
+  if (!photonErrorUndenoised.empty() && denoiseIterations.front() != 0)
+    throw Error("undenoised photon and radius errors need a denoise ladder that starts with the denoiser off");
+  if (laddersDenoiseStep < -1 || laddersDenoiseStep >= int(denoiseIterations.size()))
+    throw Error("the ladders' denoise step must be one of the denoise ladder's steps");
   if (levelError.size() != g || levelRayCost.size() != g || densityShare.size() != g)
     throw Error("level errors, level costs and density shares need one entry per group");
   auto check = [](double v, const char* what) {
@@ -153,11 +157,14 @@ double ControlProfile::denoisePasses(int step) const {
 }
 
 double ControlProfile::undenoisedWeight(int step) const {
-  if (photonErrorUndenoised.empty() || denoiseIterations.front() != 0) return 0.0;
-  const double best = *std::min_element(denoiseError.begin(), denoiseError.end());
-  const double gain = denoiseError.front() - best;
+  if (photonErrorUndenoised.empty()) return 0.0;
+  if (step == 0) return 1.0;  // the denoiser off (validate: the ladder's first step)
+  const size_t measured = laddersDenoiseStep >= 0
+                              ? size_t(laddersDenoiseStep)
+                              : size_t(std::min_element(denoiseError.begin(), denoiseError.end()) - denoiseError.begin());
+  const double gain = denoiseError.front() - denoiseError[measured];
   if (!(gain > 0.0)) return 0.0;
-  return std::clamp((denoiseError[size_t(step)] - best) / gain, 0.0, 1.0);
+  return std::clamp((denoiseError[size_t(step)] - denoiseError[measured]) / gain, 0.0, 1.0);
 }
 
 void ControlProfile::fitErrors(const ControlSetting& top, const std::function<double(const ControlSetting&)>& errorOf) {
@@ -177,6 +184,7 @@ void ControlProfile::fitErrors(const ControlSetting& top, const std::function<do
   topError = topMeasured + none;
   foveatedError = step([](ControlSetting& s) { s.foveated = true; });
   photonErrorUndenoised.clear(), radiusErrorUndenoised.clear();
+  laddersDenoiseStep = top.denoise;
   if (denoiseIterations.front() == 0 && top.denoise != 0) {
     // The same ladders from the top with the denoiser off (measured above: topMeasured + none).
     const double undenoised = topMeasured + none;
@@ -219,6 +227,8 @@ ControlProfile ControlProfile::load(const std::string& path, const std::vector<s
     p.denoiseError = readList<double>(err, "denoise", {});
     p.photonErrorUndenoised = readList<double>(err, "photons_undenoised", {});
     p.radiusErrorUndenoised = readList<double>(err, "radius_undenoised", {});
+    if (err.contains("ladders_denoise_step"))
+      p.laddersDenoiseStep = jsonNumber<int>(err["ladders_denoise_step"], "'ladders_denoise_step'");
     p.foveatedError = err.at("foveated").get<double>();
     p.foveatedSamples = cost.at("foveated_samples").get<double>();
     p.denoiseMsPerIteration = cost.value("denoise_ms_per_iteration", p.denoiseMsPerIteration);
@@ -257,6 +267,7 @@ nlohmann::json ControlProfile::toJson() const {
           {"denoise_direct_iterations", denoiseDirectIterations},
           {"error", {{"top", topError}, {"photons", photonError}, {"radius", radiusError}, {"denoise", denoiseError},
                      {"photons_undenoised", photonErrorUndenoised}, {"radius_undenoised", radiusErrorUndenoised},
+                     {"ladders_denoise_step", laddersDenoiseStep},
                      {"foveated", foveatedError}, {"groups", errGroups}}},
           {"cost", {{"groups", costGroups}, {"density_share", shares}, {"foveated_samples", foveatedSamples},
                     {"denoise_ms_per_iteration", denoiseMsPerIteration}, {"photon_map_pass_share", photonMapPassShare},

@@ -75,9 +75,10 @@ struct ControlProfile {
   // denoiser hides most of the photon map's noise, so without it fewer photons or a smaller radius
   // cost far more: on the H100's Sponza walk 512^2 photons undenoised gave relMSE 0.048 where the
   // denoised steps added up to 0.025. A denoise step takes the two ladders mixed by how much of the
-  // best step's gain it gives up (undenoisedWeight). Relative to the best photon and radius
+  // measuring step's gain it gives up (undenoisedWeight). Relative to the best photon and radius
   // steps with the denoiser off (0 there), as fitErrors measures them.
   std::vector<double> photonErrorUndenoised, radiusErrorUndenoised;
+  int laddersDenoiseStep = -1;  ///< the denoise step photonError and radiusError were measured at (-1: the least-error step)
   std::vector<std::array<double, kControlledLevels>> levelError;  ///< per group, per level (gi: 0)
   // Cost shapes: eye-ray time of each group's level relative to all at gi (whose eye rays are
   // 1), the share of the density work each group's gather points do, the foveated eye pass's time
@@ -96,9 +97,9 @@ struct ControlProfile {
   // A denoise step's cost in passes over both signals (the denoise cost's scale).
   double denoisePasses(int step) const;
   // The share of the undenoised photon and radius errors at a denoise step: 1 with the denoiser
-  // off, 0 at the step of least error (where the ladders were measured), in between the share of
-  // that step's gain over no denoiser that the step gives up. 0 wherever no undenoised ladder is
-  // known.
+  // off, 0 at the step the denoised ladders were measured at (laddersDenoiseStep), in between the
+  // share of that step's gain over no denoiser that the step gives up. 0 wherever no undenoised
+  // ladder is known.
   double undenoisedWeight(int step) const;
   // Sets the quality model from measurements: `errorOf(setting)` is the relMSE a setting gives
   // (at one view, or the mean over a walk's reference views). `top` (the best setting) and each
