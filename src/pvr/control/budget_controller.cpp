@@ -156,12 +156,14 @@ double ControlProfile::denoisePasses(int step) const {
   return double(direct) + photonMapPassShare * double(n - direct);
 }
 
+int ControlProfile::leastErrorDenoiseStep() const {
+  return int(std::min_element(denoiseError.begin(), denoiseError.end()) - denoiseError.begin());
+}
+
 double ControlProfile::undenoisedWeight(int step) const {
   if (photonErrorUndenoised.empty()) return 0.0;
   if (step == 0) return 1.0;  // the denoiser off (validate: the ladder's first step)
-  const size_t measured = laddersDenoiseStep >= 0
-                              ? size_t(laddersDenoiseStep)
-                              : size_t(std::min_element(denoiseError.begin(), denoiseError.end()) - denoiseError.begin());
+  const size_t measured = size_t(laddersDenoiseStep >= 0 ? laddersDenoiseStep : leastErrorDenoiseStep());
   const double gain = denoiseError.front() - denoiseError[measured];
   if (!(gain > 0.0)) return 0.0;
   return std::clamp((denoiseError[size_t(step)] - denoiseError[measured]) / gain, 0.0, 1.0);
@@ -169,11 +171,13 @@ double ControlProfile::undenoisedWeight(int step) const {
 
 void ControlProfile::fitErrors(const ControlSetting& top, const std::function<double(const ControlSetting&)>& errorOf) {
   const double topMeasured = errorOf(top);
-  auto step = [&](auto change) {
-    ControlSetting s = top;
+  // A knob's step from a measured setting: its error's increase (0 where the step stays there).
+  auto stepFrom = [&](const ControlSetting& from, double fromError, auto change) {
+    ControlSetting s = from;
     change(s);
-    return s == top ? 0.0 : errorOf(s) - topMeasured;
+    return s == from ? 0.0 : errorOf(s) - fromError;
   };
+  auto step = [&](auto change) { return stepFrom(top, topMeasured, change); };
   for (size_t i = 0; i < photonSides.size(); ++i)
     photonError[i] = std::max(0.0, step([&](ControlSetting& s) { s.photons = int(i); }));
   for (size_t i = 0; i < radiusScales.size(); ++i) radiusError[i] = step([&](ControlSetting& s) { s.radius = int(i); });
@@ -187,17 +191,13 @@ void ControlProfile::fitErrors(const ControlSetting& top, const std::function<do
   laddersDenoiseStep = top.denoise;
   if (denoiseIterations.front() == 0 && top.denoise != 0) {
     // The same ladders from the top with the denoiser off (measured above: topMeasured + none).
-    const double undenoised = topMeasured + none;
-    auto off = [&](auto change) {
-      ControlSetting s = top;
-      s.denoise = 0;
-      change(s);
-      return errorOf(s) - undenoised;
-    };
+    ControlSetting off = top;
+    off.denoise = 0;
     for (size_t i = 0; i < photonSides.size(); ++i)
-      photonErrorUndenoised.push_back(int(i) == top.photons ? 0.0 : std::max(0.0, off([&](ControlSetting& s) { s.photons = int(i); })));
+      photonErrorUndenoised.push_back(
+          std::max(0.0, stepFrom(off, topMeasured + none, [&](ControlSetting& s) { s.photons = int(i); })));
     for (size_t i = 0; i < radiusScales.size(); ++i)
-      radiusErrorUndenoised.push_back(int(i) == top.radius ? 0.0 : off([&](ControlSetting& s) { s.radius = int(i); }));
+      radiusErrorUndenoised.push_back(stepFrom(off, topMeasured + none, [&](ControlSetting& s) { s.radius = int(i); }));
   }
   for (size_t g = 0; g < groups.size(); ++g)
     for (int level = 0; level < kControlledLevels; ++level)
@@ -292,7 +292,7 @@ BudgetController::BudgetController(const ControlProfile& profile, const BudgetCo
   // its ceiling (gi, or lower where the options ask for less).
   best_.photons = int(profile_.photonSides.size()) - 1;
   best_.radius = int(std::min_element(profile_.radiusError.begin(), profile_.radiusError.end()) - profile_.radiusError.begin());
-  best_.denoise = int(std::min_element(profile_.denoiseError.begin(), profile_.denoiseError.end()) - profile_.denoiseError.begin());
+  best_.denoise = profile_.leastErrorDenoiseStep();
   for (int g = 0; g < groups_; ++g) {
     int ceiling = int(EffectLevel::Gi);
     if (base.gather.overrideEffects) ceiling = std::min(ceiling, int(base.gather.effects));

@@ -96,6 +96,7 @@ struct ControlProfile {
   double photonMapPassShare = 0.78;
   // A denoise step's cost in passes over both signals (the denoise cost's scale).
   double denoisePasses(int step) const;
+  int leastErrorDenoiseStep() const;  ///< the denoise step of least error (the best setting's)
   // The share of the undenoised photon and radius errors at a denoise step: 1 with the denoiser
   // off, 0 at the step the denoised ladders were measured at (laddersDenoiseStep), in between the
   // share of that step's gain over no denoiser that the step gives up. 0 wherever no undenoised
